@@ -1,0 +1,25 @@
+#pragma once
+// Every agent and tool is a subcommand of the one `drover` executable. Each subcommand
+// registers itself on the CLI11 app and reports its exit code through CommandContext.
+
+#include <CLI/CLI.hpp>
+
+namespace drover::cli {
+
+/// Exit codes shared by every Drover tool.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitFailure = 1,     ///< the operation ran and failed
+  kExitBadInput = 2,    ///< bad usage or invalid input
+  kExitNoAnswer = 3,    ///< no agent answered
+};
+
+/// Filled in by the subcommand that ran.
+struct CommandContext {
+  int exit_code = kExitOk;
+};
+
+/// `drover topology ...` (validate and friends).
+void add_topology_commands(CLI::App& app, CommandContext& context);
+
+}  // namespace drover::cli

@@ -1,0 +1,40 @@
+// `drover`: the one executable of Drover; every agent and tool is a subcommand.
+
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "agents/cli/command.hpp"
+#include "bench/bench_command.hpp"
+
+int main(int argc, char** argv) {
+  using namespace drover::cli;
+  CLI::App app{"Drover: a decentralized fleet planner for AGVs, mobile robots and people.",
+               "drover"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "drover 0.1.0");
+
+  CommandContext context;
+  add_topology_commands(app, context);
+  drover::bench::add_bench_commands(app, context);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    // Commands turn expected failures into messages themselves; this is the last guard so
+    // that nothing ever ends in an uncaught exception.
+    std::cerr << "error: internal: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  return context.exit_code;
+}

@@ -1,0 +1,35 @@
+#include "drover/common/clock.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace drover {
+
+Result<SharedClock> SharedClock::create(TimeNs epoch_ns, double factor) {
+  if (!(factor > 0.0) || !std::isfinite(factor)) {
+    return fail(ErrorCode::invalid_argument,
+                "time factor must be a positive finite number, got " + std::to_string(factor));
+  }
+  return SharedClock(epoch_ns, factor, std::chrono::steady_clock::now());
+}
+
+SharedClock SharedClock::wall() {
+  const auto unix_now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::system_clock::now().time_since_epoch());
+  return SharedClock(unix_now.count(), 1.0, std::chrono::steady_clock::now());
+}
+
+TimeNs SharedClock::now() const noexcept {
+  const auto elapsed = std::chrono::steady_clock::now() - start_;
+  return epoch_ns_ + to_sim(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed));
+}
+
+std::chrono::nanoseconds SharedClock::to_real(DurationNs sim) const noexcept {
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(sim) / factor_));
+}
+
+DurationNs SharedClock::to_sim(std::chrono::nanoseconds real) const noexcept {
+  return static_cast<DurationNs>(static_cast<double>(real.count()) * factor_);
+}
+
+}  // namespace drover

@@ -1,0 +1,40 @@
+#include <gtest/gtest.h>
+
+#include "drover/common/clock.hpp"
+
+namespace drover {
+namespace {
+
+TEST(SharedClock, RejectsNonPositiveFactor) {
+  EXPECT_FALSE(SharedClock::create(0, 0.0).has_value());
+  EXPECT_FALSE(SharedClock::create(0, -2.0).has_value());
+  EXPECT_EQ(SharedClock::create(0, -2.0).error().code, ErrorCode::invalid_argument);
+}
+
+TEST(SharedClock, ScalesRealTimeByFactor) {
+  auto clock = SharedClock::create(5 * kNsPerSecond, 10.0);
+  ASSERT_TRUE(clock.has_value());
+  EXPECT_GE(clock->now(), 5 * kNsPerSecond);
+  EXPECT_EQ(clock->to_sim(std::chrono::milliseconds(100)), kNsPerSecond);
+  EXPECT_EQ(clock->to_real(kNsPerSecond), std::chrono::milliseconds(100));
+}
+
+TEST(SharedClock, NeverGoesBackwards) {
+  auto clock = SharedClock::create(0, 1000.0);
+  ASSERT_TRUE(clock.has_value());
+  TimeNs previous = clock->now();
+  for (int i = 0; i < 1000; ++i) {
+    const TimeNs now = clock->now();
+    EXPECT_GE(now, previous);
+    previous = now;
+  }
+}
+
+TEST(Seconds, RoundTripsThroughNanoseconds) {
+  EXPECT_EQ(seconds_to_ns(1.5), 1'500'000'000);
+  EXPECT_EQ(seconds_to_ns(-0.25), -250'000'000);
+  EXPECT_DOUBLE_EQ(ns_to_seconds(2'500'000'000), 2.5);
+}
+
+}  // namespace
+}  // namespace drover

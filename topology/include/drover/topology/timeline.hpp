@@ -1,0 +1,214 @@
+#pragma once
+// Reservation timelines: per entity, who may be there when (reservations, with shadows on
+// the conflict set), when nobody may (locks), who is there now (allocation) and who waits.
+//
+// TimelineSet keeps the invariants of shared/DESIGN.md after every operation:
+//  I1 exclusive   reservations of different agents on one timeline never overlap; as
+//                 reserving e writes shadow reservations on every f in C(e), this makes
+//                 e and C(e) exclusive; at most one agent holds an allocation among them.
+//  I2 order       an agent is granted e only when no other agent's reservation (real or
+//                 shadow) on e precedes its own; waiting agents learn their queue position.
+//  I3 delay keeps order   a delay shifts the agent's remaining reservations and, where
+//                 they run into later reservations of others, those too, transitively;
+//                 the order on every timeline is unchanged; every agent moved is reported.
+//  I4 locks       a lock blocks new reservations on its entity (and, through shadows and
+//                 free-window queries, on its conflict set) during its interval; owners of
+//                 reservations it hits are reported; allocations are never revoked by it.
+//  atomic         an operation that returns an error has changed nothing.
+//
+// No DDS here: a topology agent wraps one TimelineSet (the entities it owns) and the
+// routing agent keeps a replica for planning.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drover/common/clock.hpp"
+#include "drover/common/result.hpp"
+#include "drover/topology/model.hpp"
+
+namespace drover::topology {
+
+using AgentId = std::string;
+/// Identifies a route of one agent; (agent, route) is unique.
+using RouteId = std::uint64_t;
+using LockId = std::uint64_t;
+/// Identifies a prepared (held, not yet committed) reservation set.
+using PrepareId = std::uint64_t;
+
+/// Half-open time interval [start, end); end may be kForever. Valid when start < end.
+struct Interval {
+  TimeNs start = 0;
+  TimeNs end = 0;
+
+  bool valid() const noexcept { return start < end; }
+  bool overlaps(const Interval& other) const noexcept {
+    return start < other.end && other.start < end;
+  }
+  bool contains(TimeNs t) const noexcept { return start <= t && t < end; }
+  friend bool operator==(const Interval&, const Interval&) = default;
+};
+
+/// A step of a route: the agent may occupy `entity` during `window`.
+struct RouteStep {
+  EntityIndex entity = kNoEntity;
+  Interval window;
+  friend bool operator==(const RouteStep&, const RouteStep&) = default;
+};
+
+/// One entry of an entity's timeline. A real reservation has origin == entity; a shadow
+/// reservation sits on a member of the origin's conflict set, with the origin's window.
+struct Reservation {
+  AgentId agent;
+  RouteId route = 0;
+  std::uint32_t step = 0;      ///< index of the route step it belongs to
+  EntityIndex entity = kNoEntity;  ///< the timeline it is on
+  EntityIndex origin = kNoEntity;  ///< the entity the route step reserved
+  Interval window;
+  bool prepared = false;       ///< held by an uncommitted prepare (blocks others all the same)
+
+  bool shadow() const noexcept { return origin != entity; }
+  friend bool operator==(const Reservation&, const Reservation&) = default;
+};
+
+struct Lock {
+  LockId id = 0;
+  EntityIndex entity = kNoEntity;
+  Interval window;
+  std::string operator_id;
+  std::string reason;
+  friend bool operator==(const Lock&, const Lock&) = default;
+};
+
+/// Everything about one entity, as published to observers.
+struct Timeline {
+  std::uint64_t version = 0;            ///< incremented by every change of this timeline
+  std::vector<Reservation> reservations;  ///< sorted by window.start
+  std::vector<Lock> locks;              ///< sorted by window.start
+  std::optional<AgentId> holder;        ///< the agent allocated this entity, if any
+  std::vector<AgentId> waiting;         ///< agents whose allocation requests wait, in order
+};
+
+/// Outcome of an allocation request.
+struct Allocation {
+  bool granted = false;
+  /// 0 when granted; otherwise the number of other agents' reservations on the entity
+  /// that come before the requester's (its place in the queue, 1-based).
+  std::size_t queue_position = 0;
+};
+
+/// An allocation that became possible because of a release or cancel: the topology agent
+/// answers the waiting request with it.
+struct Grant {
+  AgentId agent;
+  EntityIndex entity = kNoEntity;
+  friend bool operator==(const Grant&, const Grant&) = default;
+};
+
+/// An agent whose reservations a delay moved.
+struct Shift {
+  AgentId agent;
+  RouteId route = 0;
+  std::uint32_t from_step = 0;  ///< first step whose window moved
+  DurationNs by = 0;            ///< how far it moved
+  friend bool operator==(const Shift&, const Shift&) = default;
+};
+
+struct DelayReport {
+  std::vector<Shift> shifts;  ///< the delayed agent first, then every agent pushed by it
+  /// Reservations that now overlap a lock after shifting (their owners must re-plan).
+  std::vector<Reservation> hit_locks;
+};
+
+struct LockReport {
+  LockId id = 0;
+  std::vector<Reservation> hit;  ///< reservations (real or shadow) the lock overlaps
+};
+
+/// An entity version a plan was made against; prepare fails with `conflict` if it moved.
+struct ExpectedVersion {
+  EntityIndex entity = kNoEntity;
+  std::uint64_t version = 0;
+};
+
+/// The timelines of a set of entities (all of a topology, or one partition's).
+class TimelineSet {
+ public:
+  /// \param conflict_sets  C(e) for every entity index (Topology::conflict_sets()).
+  /// \param owned          which entities this set manages; empty means all. Operations on
+  ///                       an entity not owned fail with not_found.
+  explicit TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
+                       std::vector<bool> owned = {});
+
+  std::size_t entity_count() const noexcept;
+  bool owns(EntityIndex entity) const noexcept;
+  /// \pre owns(entity)
+  const Timeline& timeline(EntityIndex entity) const;
+  std::uint64_t version(EntityIndex entity) const;
+
+  /// The reservations (real and shadow) a route writes: one real per step, plus a shadow
+  /// on every f in C(step.entity). Pure; used by routing agents to split a route by owner.
+  std::vector<Reservation> expand(const AgentId& agent, RouteId route,
+                                  const std::vector<RouteStep>& steps) const;
+
+  /// Windows within [from, until) in which `agent` could occupy `entity`: free of other
+  /// agents' reservations on its timeline and of locks on it and on C(entity). Sorted,
+  /// disjoint, maximal. The agent's own reservations never block it.
+  std::vector<Interval> free_windows(EntityIndex entity, const AgentId& agent, TimeNs from,
+                                     TimeNs until) const;
+
+  /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
+  /// overlaps another agent's reservation or a lock, or if an expected version moved;
+  /// invalid_argument for an empty set, a bad window or mixed agents/routes; not_found for
+  /// an entity not owned. Held items block others until commit, abort or expiry.
+  Result<PrepareId> prepare(const std::vector<Reservation>& items,
+                            const std::vector<ExpectedVersion>& expected, TimeNs expires_at);
+  /// Makes a prepared set permanent. not_found if it was aborted or expired.
+  Status commit(PrepareId id);
+  /// Drops a prepared set. not_found if unknown.
+  Status abort(PrepareId id);
+  /// Drops every prepared set whose expiry is <= now (presumed abort); returns their ids.
+  std::vector<PrepareId> expire(TimeNs now);
+
+  /// prepare + commit in one step.
+  Status reserve(const AgentId& agent, RouteId route, const std::vector<RouteStep>& steps);
+
+  /// Asks for the allocation of `entity`, where the agent must hold a committed real
+  /// reservation. Granted when no other agent's reservation on the entity precedes the
+  /// agent's first one; otherwise queued (answered later through a Grant).
+  /// Asking again while queued or holding is harmless and reports the current state.
+  Result<Allocation> allocate(const AgentId& agent, EntityIndex entity);
+
+  /// Gives up the allocation of `entity`: removes the agent's allocated reservation there
+  /// and its shadows. not_permitted if the agent does not hold it.
+  /// \return the waiting requests that this made grantable (now granted).
+  Result<std::vector<Grant>> release(const AgentId& agent, EntityIndex entity);
+
+  /// Removes every reservation of (agent, route) that is not allocated, with shadows, and
+  /// withdraws its waiting requests. not_found if the route has nothing here.
+  Result<std::vector<Grant>> cancel_route(const AgentId& agent, RouteId route);
+
+  /// Delay of `by` (> 0) for `agent`'s route from its step on `entity` on: that step's
+  /// window ends `by` later and the later steps move by `by`; every later reservation of
+  /// another agent they run into moves as far as needed, transitively (I3). Open ends stay
+  /// open. not_found if the agent has no reservation of the route on the entity.
+  Result<DelayReport> delay(const AgentId& agent, RouteId route, EntityIndex entity,
+                            DurationNs by);
+
+  /// Locks `entity` during `window`. invalid_argument for a bad window or empty operator.
+  Result<LockReport> lock(EntityIndex entity, Interval window, std::string operator_id,
+                          std::string reason);
+  /// Removes a lock. not_found if unknown.
+  Status unlock(LockId id);
+
+ private:
+  struct Impl;
+  std::vector<std::vector<EntityIndex>> conflict_sets_;
+  std::vector<bool> owned_;
+  std::vector<Timeline> timelines_;
+  // Implementation state (prepared sets, id counters, pending requests) lives in the
+  // source file's helpers; see timeline.cpp.
+};
+
+}  // namespace drover::topology
