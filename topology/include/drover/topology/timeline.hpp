@@ -20,8 +20,10 @@
 // routing agent keeps a replica for planning.
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drover/common/clock.hpp"
@@ -84,10 +86,14 @@ struct Lock {
 /// Everything about one entity, as published to observers.
 struct Timeline {
   std::uint64_t version = 0;            ///< incremented by every change of this timeline
-  std::vector<Reservation> reservations;  ///< sorted by window.start
-  std::vector<Lock> locks;              ///< sorted by window.start
+  /// sorted by window.start; ties (only an agent's own items) by end, agent, route,
+  /// step, origin
+  std::vector<Reservation> reservations;
+  std::vector<Lock> locks;              ///< sorted by window.start, then id
   std::optional<AgentId> holder;        ///< the agent allocated this entity, if any
   std::vector<AgentId> waiting;         ///< agents whose allocation requests wait, in order
+
+  friend bool operator==(const Timeline&, const Timeline&) = default;
 };
 
 /// Outcome of an allocation request.
@@ -116,14 +122,18 @@ struct Shift {
 };
 
 struct DelayReport {
-  std::vector<Shift> shifts;  ///< the delayed agent first, then every agent pushed by it
-  /// Reservations that now overlap a lock after shifting (their owners must re-plan).
+  /// The delayed route first, then every route pushed by it, by (agent, route). A pushed
+  /// route waits longer at its step from_step and arrives later from there on; `by` is how
+  /// far its last step moved (its largest shift).
+  std::vector<Shift> shifts;
+  /// Reservations that moved and now overlap a lock on their timeline (their owners must
+  /// re-plan), with their new windows, by entity then in timeline order.
   std::vector<Reservation> hit_locks;
 };
 
 struct LockReport {
   LockId id = 0;
-  std::vector<Reservation> hit;  ///< reservations (real or shadow) the lock overlaps
+  std::vector<Reservation> hit;  ///< reservations (real or shadow) the lock overlaps, in timeline order
 };
 
 /// An entity version a plan was made against; prepare fails with `conflict` if it moved.
@@ -135,16 +145,23 @@ struct ExpectedVersion {
 /// The timelines of a set of entities (all of a topology, or one partition's).
 class TimelineSet {
  public:
-  /// \param conflict_sets  C(e) for every entity index (Topology::conflict_sets()).
-  /// \param owned          which entities this set manages; empty means all. Operations on
-  ///                       an entity not owned fail with not_found.
+  /// \param conflict_sets  C(e) for every entity index (Topology::conflict_sets()); must be
+  ///                       symmetric. Out-of-range indices and e itself are ignored.
+  /// \param owned          which entities this set manages; empty means all, entities past
+  ///                       its end are not owned. Operations on an entity not owned fail
+  ///                       with not_found; shadows on entities not owned are their owner's.
   explicit TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
                        std::vector<bool> owned = {});
+
+  /// Equal when every timeline, prepared set, lock and id counter is (a rejected operation
+  /// leaves the set equal to a copy taken before it).
+  friend bool operator==(const TimelineSet&, const TimelineSet&) = default;
 
   std::size_t entity_count() const noexcept;
   bool owns(EntityIndex entity) const noexcept;
   /// \pre owns(entity)
   const Timeline& timeline(EntityIndex entity) const;
+  /// The entity's version (0 for an entity out of range).
   std::uint64_t version(EntityIndex entity) const;
 
   /// The reservations (real and shadow) a route writes: one real per step, plus a shadow
@@ -155,60 +172,127 @@ class TimelineSet {
   /// Windows within [from, until) in which `agent` could occupy `entity`: free of other
   /// agents' reservations on its timeline and of locks on it and on C(entity). Sorted,
   /// disjoint, maximal. The agent's own reservations never block it.
+  /// As a step on `entity` also writes shadows on C(entity), other agents' reservations
+  /// on the owned members of C(entity) block too, and so does everything up to the end of
+  /// another agent's allocated reservation there (nobody may come before a holder): a
+  /// step whose window lies in one of these windows is accepted by prepare (versions
+  /// aside), as far as the owned entities go. Empty for an entity not owned.
   std::vector<Interval> free_windows(EntityIndex entity, const AgentId& agent, TimeNs from,
                                      TimeNs until) const;
+
+  /// The windows free_windows(entity, agent, from, until) returns, appended to `out`
+  /// instead of returned, so a planner reusing `out` allocates nothing once it is large
+  /// enough. With count_locks false, locks are ignored (a planner asks whether a route
+  /// would exist without them, to explain a failure). Nothing is appended for an entity
+  /// not owned. Implemented in timeline_query.cpp.
+  void append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
+                           TimeNs until, std::vector<Interval>& out,
+                           bool count_locks = true) const;
 
   /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
   /// overlaps another agent's reservation or a lock, or if an expected version moved;
   /// invalid_argument for an empty set, a bad window or mixed agents/routes; not_found for
   /// an entity not owned. Held items block others until commit, abort or expiry.
+  /// Also conflict: an item that would come before another agent's allocated reservation
+  /// on its timeline (a holder is never overtaken), or a step of the route that already
+  /// has reservations here. invalid_argument too: an empty agent id, a shadow that is not
+  /// on a member of its origin's conflict set, items of one step with different origins
+  /// or windows, the same item twice. Checks run in that order of codes: every
+  /// invalid_argument first, then not_found, then conflict.
   Result<PrepareId> prepare(const std::vector<Reservation>& items,
                             const std::vector<ExpectedVersion>& expected, TimeNs expires_at);
   /// Makes a prepared set permanent. not_found if it was aborted or expired.
   Status commit(PrepareId id);
   /// Drops a prepared set. not_found if unknown.
   Status abort(PrepareId id);
-  /// Drops every prepared set whose expiry is <= now (presumed abort); returns their ids.
+  /// Drops every prepared set whose expiry is <= now (presumed abort); returns their ids,
+  /// ascending.
   std::vector<PrepareId> expire(TimeNs now);
 
-  /// prepare + commit in one step.
+  /// The grants that abort and expire made (they free held items that waiting requests may
+  /// have queued behind, but report no grants themselves) since the last call, in the order
+  /// they were made.
+  std::vector<Grant> take_grants();
+
+  /// prepare + commit in one step, of the items expand() writes on owned entities. Every
+  /// step's entity must be owned (not_found); invalid_argument for no steps, an empty agent
+  /// id or a bad window.
   Status reserve(const AgentId& agent, RouteId route, const std::vector<RouteStep>& steps);
 
   /// Asks for the allocation of `entity`, where the agent must hold a committed real
   /// reservation. Granted when no other agent's reservation on the entity precedes the
   /// agent's first one; otherwise queued (answered later through a Grant).
   /// Asking again while queued or holding is harmless and reports the current state.
+  /// not_found if the entity is not owned or the agent has no committed real reservation
+  /// on it; invalid_argument for an empty agent id.
   Result<Allocation> allocate(const AgentId& agent, EntityIndex entity);
 
   /// Gives up the allocation of `entity`: removes the agent's allocated reservation there
   /// and its shadows. not_permitted if the agent does not hold it.
-  /// \return the waiting requests that this made grantable (now granted).
+  /// \return the waiting requests that this made grantable (now granted), by entity.
   Result<std::vector<Grant>> release(const AgentId& agent, EntityIndex entity);
 
-  /// Removes every reservation of (agent, route) that is not allocated, with shadows, and
-  /// withdraws its waiting requests. not_found if the route has nothing here.
+  /// Removes every reservation of (agent, route) that is not allocated, with shadows, also
+  /// held (prepared) ones, whose prepared sets are dropped; withdraws the agent's waiting
+  /// requests where no committed reservation of it is left. not_found if the route has
+  /// nothing here. \return the waiting requests this made grantable (now granted), by entity.
   Result<std::vector<Grant>> cancel_route(const AgentId& agent, RouteId route);
 
   /// Delay of `by` (> 0) for `agent`'s route from its step on `entity` on: that step's
   /// window ends `by` later and the later steps move by `by`; every later reservation of
   /// another agent they run into moves as far as needed, transitively (I3). Open ends stay
   /// open. not_found if the agent has no reservation of the route on the entity.
+  /// The step is the route's real reservation on `entity`, else its shadow there (the
+  /// owner of a neighbour's shadows delays them this way). A pushed route's step that
+  /// would start before its blocker ends starts when it ends: the route waits that much
+  /// longer at the previous step (its first step moves whole) and moves on from there,
+  /// each route by no more than needed. Allocations and waiting requests are unchanged
+  /// (the order on every timeline is). invalid_argument if a time would pass kForever.
   Result<DelayReport> delay(const AgentId& agent, RouteId route, EntityIndex entity,
                             DurationNs by);
 
-  /// Locks `entity` during `window`. invalid_argument for a bad window or empty operator.
+  /// Locks `entity` during `window`. invalid_argument for a bad window or empty operator,
+  /// not_found for an entity not owned. Reservations already there stay (see LockReport).
   Result<LockReport> lock(EntityIndex entity, Interval window, std::string operator_id,
                           std::string reason);
   /// Removes a lock. not_found if unknown.
   Status unlock(LockId id);
 
  private:
-  struct Impl;
+  struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
+
+  /// Names one reservation of the set within a prepared set's (agent, route). Prepared
+  /// sets remember keys, not copies, because a delay may move held items before commit.
+  struct ItemKey {
+    EntityIndex entity = kNoEntity;
+    std::uint32_t step = 0;
+    EntityIndex origin = kNoEntity;
+    friend bool operator==(const ItemKey&, const ItemKey&) = default;
+  };
+  struct PreparedSet {
+    AgentId agent;
+    RouteId route = 0;
+    TimeNs expires_at = 0;
+    std::vector<ItemKey> items;
+    friend bool operator==(const PreparedSet&, const PreparedSet&) = default;
+  };
+  /// Which reservation an allocation holds: the holder's real reservation of this route
+  /// step on the entity, and the step's shadows on the conflict set.
+  struct HeldStep {
+    RouteId route = 0;
+    std::uint32_t step = 0;
+    friend bool operator==(const HeldStep&, const HeldStep&) = default;
+  };
+
   std::vector<std::vector<EntityIndex>> conflict_sets_;
-  std::vector<bool> owned_;
+  std::vector<bool> owned_;                       // one flag per entity
   std::vector<Timeline> timelines_;
-  // Implementation state (prepared sets, id counters, pending requests) lives in the
-  // source file's helpers; see timeline.cpp.
+  std::vector<std::optional<HeldStep>> held_;     // per entity; set iff its holder is
+  std::map<PrepareId, PreparedSet> prepared_;
+  std::map<LockId, EntityIndex> lock_entities_;   // where each lock lives
+  std::vector<Grant> pending_grants_;             // made by abort/expire, see take_grants
+  LockId next_lock_id_ = 1;
+  PrepareId next_prepare_id_ = 1;
 };
 
 }  // namespace drover::topology

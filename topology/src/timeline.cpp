@@ -1,0 +1,192 @@
+// TimelineSet: construction, queries (expand, free windows), locks and the helpers shared
+// by the other timeline sources. Prepare/commit live in timeline_prepare.cpp, allocation in
+// timeline_allocation.cpp, delay propagation in timeline_delay.cpp.
+
+#include <algorithm>
+#include <cassert>
+#include <functional>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include <boost/icl/interval_set.hpp>
+#include <boost/icl/right_open_interval.hpp>
+
+#include "drover/topology/timeline.hpp"
+#include "timeline_impl.hpp"
+
+namespace drover::topology {
+namespace {
+
+using Window = boost::icl::right_open_interval<TimeNs>;
+using WindowSet = boost::icl::interval_set<TimeNs, std::less, Window>;
+
+/// Drops out-of-range indices and self references; sorts and deduplicates each set.
+std::vector<std::vector<EntityIndex>> clean_conflict_sets(
+    std::vector<std::vector<EntityIndex>> sets) {
+  const std::size_t count = sets.size();
+  for (std::size_t e = 0; e < count; ++e) {
+    auto& set = sets[e];
+    std::erase_if(set, [&](EntityIndex f) { return f >= count || f == e; });
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+  }
+  return sets;
+}
+
+std::vector<bool> owned_flags(std::vector<bool> owned, std::size_t count) {
+  if (owned.empty()) return std::vector<bool>(count, true);
+  owned.resize(count, false);
+  return owned;
+}
+
+}  // namespace
+
+// ---- shared helpers -------------------------------------------------------------------
+
+bool TimelineSet::Impl::timeline_order(const Reservation& a, const Reservation& b) {
+  return std::tie(a.window.start, a.window.end, a.agent, a.route, a.step, a.origin) <
+         std::tie(b.window.start, b.window.end, b.agent, b.route, b.step, b.origin);
+}
+
+void TimelineSet::Impl::sort_reservations(Timeline& timeline) {
+  std::sort(timeline.reservations.begin(), timeline.reservations.end(), timeline_order);
+}
+
+void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touched) {
+  for (EntityIndex entity : touched) ++set.timelines_[entity].version;
+}
+
+bool TimelineSet::Impl::in_conflict_set(const TimelineSet& set, EntityIndex origin,
+                                        EntityIndex entity) {
+  const auto& conflicts = set.conflict_sets_[origin];
+  return std::binary_search(conflicts.begin(), conflicts.end(), entity);
+}
+
+bool TimelineSet::Impl::is_held(const TimelineSet& set, const Reservation& r) {
+  if (!set.owns(r.origin)) return false;
+  const auto& held = set.held_[r.origin];
+  return held && set.timelines_[r.origin].holder == r.agent && held->route == r.route &&
+         held->step == r.step;
+}
+
+void TimelineSet::Impl::remove_reservations(
+    TimelineSet& set, const std::function<bool(const Reservation&)>& doomed,
+    TouchedSet& touched) {
+  for (EntityIndex entity = 0; entity < set.timelines_.size(); ++entity) {
+    if (std::erase_if(set.timelines_[entity].reservations, doomed) > 0) touched.insert(entity);
+  }
+}
+
+// ---- construction and queries ----------------------------------------------------------
+
+TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
+                         std::vector<bool> owned)
+    : conflict_sets_(clean_conflict_sets(std::move(conflict_sets))),
+      owned_(owned_flags(std::move(owned), conflict_sets_.size())),
+      timelines_(conflict_sets_.size()),
+      held_(conflict_sets_.size()) {}
+
+std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }
+
+bool TimelineSet::owns(EntityIndex entity) const noexcept {
+  return entity < owned_.size() && owned_[entity];
+}
+
+const Timeline& TimelineSet::timeline(EntityIndex entity) const {
+  assert(entity < timelines_.size());
+  return timelines_[entity];
+}
+
+std::uint64_t TimelineSet::version(EntityIndex entity) const {
+  return entity < timelines_.size() ? timelines_[entity].version : 0;
+}
+
+std::vector<Reservation> TimelineSet::expand(const AgentId& agent, RouteId route,
+                                             const std::vector<RouteStep>& steps) const {
+  std::vector<Reservation> items;
+  for (std::uint32_t step = 0; step < steps.size(); ++step) {
+    const RouteStep& s = steps[step];
+    items.push_back(Reservation{agent, route, step, s.entity, s.entity, s.window, false});
+    if (s.entity >= conflict_sets_.size()) continue;  // prepare reports it
+    for (EntityIndex f : conflict_sets_[s.entity]) {
+      items.push_back(Reservation{agent, route, step, f, s.entity, s.window, false});
+    }
+  }
+  return items;
+}
+
+std::vector<Interval> TimelineSet::free_windows(EntityIndex entity, const AgentId& agent,
+                                                TimeNs from, TimeNs until) const {
+  if (!owns(entity) || from >= until) return {};
+  WindowSet free;
+  free += Window(from, until);
+  const auto block = [&](TimeNs start, TimeNs end) {
+    if (start < end) free -= Window(start, end);
+  };
+  // A step on `entity` writes items on entity and on C(entity): each of those timelines
+  // must accept them (see prepare).
+  const auto block_timeline = [&](EntityIndex x) {
+    const Timeline& t = timelines_[x];
+    for (const Lock& lock : t.locks) block(lock.window.start, lock.window.end);
+    for (const Reservation& r : t.reservations) {
+      if (r.agent == agent) continue;
+      // Nobody may come before a holder: everything up to its end is taken.
+      block(Impl::is_held(*this, r) ? from : r.window.start, r.window.end);
+    }
+  };
+  block_timeline(entity);
+  for (EntityIndex f : conflict_sets_[entity]) {
+    if (owns(f)) block_timeline(f);
+  }
+  std::vector<Interval> windows;
+  for (const Window& w : free) windows.push_back(Interval{w.lower(), w.upper()});
+  return windows;
+}
+
+// ---- locks --------------------------------------------------------------------------------
+
+Result<LockReport> TimelineSet::lock(EntityIndex entity, Interval window,
+                                     std::string operator_id, std::string reason) {
+  if (!window.valid()) {
+    return fail(ErrorCode::invalid_argument,
+                "lock: window [" + std::to_string(window.start) + ", " +
+                    std::to_string(window.end) + ") of entity " + std::to_string(entity) +
+                    " is empty or reversed");
+  }
+  if (operator_id.empty()) {
+    return fail(ErrorCode::invalid_argument,
+                "lock: entity " + std::to_string(entity) + ": empty operator id");
+  }
+  if (!owns(entity)) {
+    return fail(ErrorCode::not_found,
+                "lock: entity " + std::to_string(entity) + " is not owned by this set");
+  }
+  Timeline& t = timelines_[entity];
+  LockReport report;
+  report.id = next_lock_id_++;
+  for (const Reservation& r : t.reservations) {
+    if (r.window.overlaps(window)) report.hit.push_back(r);
+  }
+  t.locks.push_back(Lock{report.id, entity, window, std::move(operator_id), std::move(reason)});
+  std::sort(t.locks.begin(), t.locks.end(), [](const Lock& a, const Lock& b) {
+    return std::tie(a.window.start, a.id) < std::tie(b.window.start, b.id);
+  });
+  lock_entities_.emplace(report.id, entity);
+  ++t.version;
+  return report;
+}
+
+Status TimelineSet::unlock(LockId id) {
+  const auto found = lock_entities_.find(id);
+  if (found == lock_entities_.end()) {
+    return fail(ErrorCode::not_found, "unlock: no lock with id " + std::to_string(id));
+  }
+  Timeline& t = timelines_[found->second];
+  std::erase_if(t.locks, [&](const Lock& lock) { return lock.id == id; });
+  ++t.version;
+  lock_entities_.erase(found);
+  return {};
+}
+
+}  // namespace drover::topology

@@ -1,0 +1,136 @@
+// TimelineSet: allocation strictly in reservation order (I2), release, cancel_route, and
+// the grants of waiting requests that a removal makes possible.
+
+#include <algorithm>
+#include <string>
+#include <utility>
+
+#include "drover/topology/timeline.hpp"
+#include "timeline_impl.hpp"
+
+namespace drover::topology {
+
+const Reservation* TimelineSet::Impl::first_committed_real(const Timeline& timeline,
+                                                          const AgentId& agent) {
+  for (const Reservation& r : timeline.reservations) {  // in start order
+    if (r.agent == agent && !r.shadow() && !r.prepared) return &r;
+  }
+  return nullptr;
+}
+
+std::size_t TimelineSet::Impl::others_before(const Timeline& timeline, const AgentId& agent,
+                                             TimeNs start) {
+  return static_cast<std::size_t>(
+      std::count_if(timeline.reservations.begin(), timeline.reservations.end(),
+                    [&](const Reservation& r) { return r.agent != agent && r.window.start < start; }));
+}
+
+std::vector<Grant> TimelineSet::Impl::grant_waiting(TimelineSet& set, const TouchedSet& entities,
+                                                    TouchedSet& touched) {
+  std::vector<Grant> grants;
+  for (EntityIndex entity : entities) {
+    Timeline& t = set.timelines_[entity];
+    if (std::erase_if(t.waiting, [&](const AgentId& agent) {
+          return first_committed_real(t, agent) == nullptr;
+        }) > 0) {
+      touched.insert(entity);
+    }
+    if (t.holder) continue;
+    for (auto waiting = t.waiting.begin(); waiting != t.waiting.end(); ++waiting) {
+      const Reservation* mine = first_committed_real(t, *waiting);
+      if (others_before(t, *waiting, mine->window.start) > 0) continue;
+      set.held_[entity] = HeldStep{mine->route, mine->step};
+      t.holder = *waiting;
+      grants.push_back(Grant{*waiting, entity});
+      t.waiting.erase(waiting);
+      touched.insert(entity);
+      break;  // one holder per entity
+    }
+  }
+  return grants;
+}
+
+Result<Allocation> TimelineSet::allocate(const AgentId& agent, EntityIndex entity) {
+  if (agent.empty()) return fail(ErrorCode::invalid_argument, "allocate: empty agent id");
+  if (!owns(entity)) {
+    return fail(ErrorCode::not_found,
+                "allocate: entity " + std::to_string(entity) + " is not owned by this set");
+  }
+  Timeline& t = timelines_[entity];
+  if (t.holder == agent) return Allocation{true, 0};
+  const Reservation* mine = Impl::first_committed_real(t, agent);
+  if (mine == nullptr) {
+    return fail(ErrorCode::not_found, "allocate: agent " + agent +
+                                          " has no committed reservation on entity " +
+                                          std::to_string(entity));
+  }
+  const std::size_t ahead = Impl::others_before(t, agent, mine->window.start);
+  if (!t.holder && ahead == 0) {
+    held_[entity] = HeldStep{mine->route, mine->step};
+    t.holder = agent;
+    std::erase(t.waiting, agent);
+    ++t.version;
+    return Allocation{true, 0};
+  }
+  // A holder's allocated reservation always comes first (nobody may be placed before
+  // it), so a request behind a holder has ahead >= 1.
+  if (std::find(t.waiting.begin(), t.waiting.end(), agent) == t.waiting.end()) {
+    t.waiting.push_back(agent);
+    ++t.version;
+  }
+  return Allocation{false, ahead};
+}
+
+Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityIndex entity) {
+  if (agent.empty()) return fail(ErrorCode::invalid_argument, "release: empty agent id");
+  if (!owns(entity)) {
+    return fail(ErrorCode::not_found,
+                "release: entity " + std::to_string(entity) + " is not owned by this set");
+  }
+  Timeline& t = timelines_[entity];
+  if (t.holder != agent) {
+    return fail(ErrorCode::not_permitted,
+                "release: agent " + agent + " does not hold entity " + std::to_string(entity) +
+                    (t.holder ? " (held by " + *t.holder + ")" : " (nobody holds it)"));
+  }
+  const HeldStep held = *held_[entity];
+  TouchedSet touched{entity};
+  const auto allocated = [&](const Reservation& r) {
+    return r.agent == agent && r.route == held.route && r.step == held.step &&
+           r.origin == entity;
+  };
+  std::erase_if(t.reservations, allocated);
+  for (EntityIndex f : conflict_sets_[entity]) {
+    if (owns(f) && std::erase_if(timelines_[f].reservations, allocated) > 0) touched.insert(f);
+  }
+  t.holder.reset();
+  held_[entity].reset();
+  std::vector<Grant> grants = Impl::grant_waiting(*this, TouchedSet(touched), touched);
+  Impl::bump_versions(*this, touched);
+  return grants;
+}
+
+Result<std::vector<Grant>> TimelineSet::cancel_route(const AgentId& agent, RouteId route) {
+  if (agent.empty()) return fail(ErrorCode::invalid_argument, "cancel_route: empty agent id");
+  const auto of_route = [&](const Reservation& r) { return r.agent == agent && r.route == route; };
+  const bool known = std::any_of(timelines_.begin(), timelines_.end(), [&](const Timeline& t) {
+    return std::any_of(t.reservations.begin(), t.reservations.end(), of_route);
+  });
+  if (!known) {
+    return fail(ErrorCode::not_found, "cancel_route: agent " + agent + " has no route " +
+                                          std::to_string(route) + " here");
+  }
+  TouchedSet touched;
+  // Decide with the allocation state before anything is removed.
+  Impl::remove_reservations(
+      *this, [&](const Reservation& r) { return of_route(r) && !Impl::is_held(*this, r); },
+      touched);
+  std::erase_if(prepared_, [&](const auto& entry) {
+    return entry.second.agent == agent && entry.second.route == route;
+  });
+  std::vector<Grant> grants = Impl::grant_waiting(*this, TouchedSet(touched), touched);
+  Impl::bump_versions(*this, touched);
+  return grants;
+}
+
+}  // namespace drover::topology

@@ -1,0 +1,51 @@
+#pragma once
+// Helpers shared by the TimelineSet sources (timeline*.cpp). Private to the library.
+
+#include <functional>
+#include <set>
+#include <vector>
+
+#include "drover/topology/timeline.hpp"
+
+namespace drover::topology {
+
+/// The entities an operation changed; each gets its version incremented once at the end.
+using TouchedSet = std::set<EntityIndex>;
+
+struct TimelineSet::Impl {
+  /// Timeline order (see Timeline::reservations).
+  static bool timeline_order(const Reservation& a, const Reservation& b);
+  static void sort_reservations(Timeline& timeline);
+  static void bump_versions(TimelineSet& set, const TouchedSet& touched);
+
+  static bool in_conflict_set(const TimelineSet& set, EntityIndex origin, EntityIndex entity);
+
+  /// True when `r` belongs to an allocation: r's origin is owned and held by r's agent at
+  /// r's route step (so r is the held real reservation or one of its shadows).
+  static bool is_held(const TimelineSet& set, const Reservation& r);
+
+  /// Removes the reservations `doomed` selects from every owned timeline; records where.
+  static void remove_reservations(TimelineSet& set,
+                                  const std::function<bool(const Reservation&)>& doomed,
+                                  TouchedSet& touched);
+
+  /// Removes a prepared set and its items, grants what that made grantable (kept for
+  /// take_grants) and increments the versions of what changed.
+  static void drop_prepared(TimelineSet& set, PrepareId id);
+
+  /// The agent's first committed real reservation on the timeline, or nullptr.
+  static const Reservation* first_committed_real(const Timeline& timeline,
+                                                 const AgentId& agent);
+  /// How many reservations of other agents start before `start` on the timeline.
+  static std::size_t others_before(const Timeline& timeline, const AgentId& agent,
+                                   TimeNs start);
+
+  /// On each of `entities`: drops waiting requests whose agent has no committed real
+  /// reservation left there, then grants the waiting request that has become grantable,
+  /// if any (at most one can be). Records what changed in `touched`.
+  /// \return the grants, by entity.
+  static std::vector<Grant> grant_waiting(TimelineSet& set, const TouchedSet& entities,
+                                          TouchedSet& touched);
+};
+
+}  // namespace drover::topology

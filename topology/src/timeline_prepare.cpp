@@ -1,0 +1,242 @@
+// TimelineSet: two-phase reservation (prepare / commit / abort / expire) and reserve.
+// prepare validates everything before it changes anything, so a rejection changes nothing.
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "drover/topology/timeline.hpp"
+#include "timeline_impl.hpp"
+
+namespace drover::topology {
+namespace {
+
+std::string window_text(const Interval& w) {
+  return "[" + std::to_string(w.start) + ", " +
+         (w.end == kForever ? std::string("forever") : std::to_string(w.end)) + ")";
+}
+
+std::string item_text(std::size_t index, const Reservation& item) {
+  return "item " + std::to_string(index) + " (entity " + std::to_string(item.entity) +
+         ", step " + std::to_string(item.step) + ", " + window_text(item.window) + ")";
+}
+
+std::string owner_text(const Reservation& r) {
+  return "agent " + r.agent + " route " + std::to_string(r.route) + " step " +
+         std::to_string(r.step) + " " + window_text(r.window);
+}
+
+/// The checks of prepare that need no timeline: well-formed, one route, consistent steps.
+Status check_well_formed(const std::vector<Reservation>& items, std::size_t entity_count,
+                         const std::function<bool(EntityIndex, EntityIndex)>& conflicts) {
+  if (items.empty()) return fail(ErrorCode::invalid_argument, "prepare: no items");
+  const Reservation& first = items.front();
+  std::map<std::uint32_t, std::size_t> first_of_step;
+  std::set<std::pair<EntityIndex, std::uint32_t>> seen;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Reservation& item = items[i];
+    const std::string where = "prepare: " + item_text(i, item);
+    if (item.agent.empty()) {
+      return fail(ErrorCode::invalid_argument, where + ": empty agent id");
+    }
+    if (item.agent != first.agent || item.route != first.route) {
+      return fail(ErrorCode::invalid_argument,
+                  where + ": belongs to agent " + item.agent + " route " +
+                      std::to_string(item.route) + ", item 0 to agent " + first.agent +
+                      " route " + std::to_string(first.route) + " (one route per prepare)");
+    }
+    if (!item.window.valid()) {
+      return fail(ErrorCode::invalid_argument, where + ": empty or reversed window");
+    }
+    if (item.origin >= entity_count) {
+      return fail(ErrorCode::invalid_argument,
+                  where + ": origin " + std::to_string(item.origin) + " is out of range");
+    }
+    if (item.entity < entity_count && item.entity != item.origin &&
+        !conflicts(item.origin, item.entity)) {
+      return fail(ErrorCode::invalid_argument,
+                  where + ": a shadow of entity " + std::to_string(item.origin) +
+                      ", which does not conflict with it");
+    }
+    const auto [step_first, inserted] = first_of_step.emplace(item.step, i);
+    const Reservation& same_step = items[step_first->second];
+    if (!inserted && (same_step.origin != item.origin || same_step.window != item.window)) {
+      return fail(ErrorCode::invalid_argument,
+                  where + ": its step has origin " + std::to_string(same_step.origin) + " " +
+                      window_text(same_step.window) + " in item " +
+                      std::to_string(step_first->second));
+    }
+    if (!seen.emplace(item.entity, item.step).second) {
+      return fail(ErrorCode::invalid_argument, where + ": appears twice");
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
+                                       const std::vector<ExpectedVersion>& expected,
+                                       TimeNs expires_at) {
+  if (auto well_formed = check_well_formed(
+          items, entity_count(),
+          [this](EntityIndex origin, EntityIndex entity) {
+            return Impl::in_conflict_set(*this, origin, entity);
+          });
+      !well_formed) {
+    return unexpected(std::move(well_formed).error());
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (!owns(items[i].entity)) {
+      return fail(ErrorCode::not_found, "prepare: " + item_text(i, items[i]) +
+                                            ": entity not owned by this set");
+    }
+  }
+  for (const ExpectedVersion& ev : expected) {
+    if (!owns(ev.entity)) {
+      return fail(ErrorCode::not_found, "prepare: expected version of entity " +
+                                            std::to_string(ev.entity) +
+                                            ", which this set does not own");
+    }
+  }
+  for (const ExpectedVersion& ev : expected) {
+    if (version(ev.entity) != ev.version) {
+      return fail(ErrorCode::conflict,
+                  "prepare: entity " + std::to_string(ev.entity) + " is at version " +
+                      std::to_string(version(ev.entity)) + ", the plan expected version " +
+                      std::to_string(ev.version));
+    }
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Reservation& item = items[i];
+    const Timeline& t = timelines_[item.entity];
+    const std::string where = "prepare: " + item_text(i, item);
+    for (const Reservation& r : t.reservations) {
+      if (r.agent == item.agent) {
+        if (r.route == item.route && r.step == item.step) {
+          return fail(ErrorCode::conflict, where + ": the step is already reserved here");
+        }
+        continue;
+      }
+      if (r.window.overlaps(item.window)) {
+        return fail(ErrorCode::conflict, where + ": overlaps " + owner_text(r));
+      }
+      if (item.window.start < r.window.start && Impl::is_held(*this, r)) {
+        return fail(ErrorCode::conflict,
+                    where + ": would come before the allocated " + owner_text(r));
+      }
+    }
+    for (const Lock& lock : t.locks) {
+      if (lock.window.overlaps(item.window)) {
+        return fail(ErrorCode::conflict, where + ": overlaps lock " + std::to_string(lock.id) +
+                                             " " + window_text(lock.window) + " (" +
+                                             lock.reason + ")");
+      }
+    }
+  }
+
+  // Everything checked: apply.
+  PreparedSet held{items.front().agent, items.front().route, expires_at, {}};
+  TouchedSet touched;
+  for (const Reservation& item : items) {
+    Reservation r = item;
+    r.prepared = true;
+    timelines_[r.entity].reservations.push_back(std::move(r));
+    held.items.push_back(ItemKey{item.entity, item.step, item.origin});
+    touched.insert(item.entity);
+  }
+  for (EntityIndex entity : touched) Impl::sort_reservations(timelines_[entity]);
+  Impl::bump_versions(*this, touched);
+  const PrepareId id = next_prepare_id_++;
+  prepared_.emplace(id, std::move(held));
+  return id;
+}
+
+Status TimelineSet::commit(PrepareId id) {
+  const auto found = prepared_.find(id);
+  if (found == prepared_.end()) {
+    return fail(ErrorCode::not_found,
+                "commit: prepared set " + std::to_string(id) + " is unknown, aborted or expired");
+  }
+  const PreparedSet& held = found->second;
+  TouchedSet touched;
+  for (const ItemKey& key : held.items) {
+    for (Reservation& r : timelines_[key.entity].reservations) {
+      if (r.prepared && r.agent == held.agent && r.route == held.route && r.step == key.step &&
+          r.origin == key.origin) {
+        r.prepared = false;
+      }
+    }
+    touched.insert(key.entity);
+  }
+  Impl::bump_versions(*this, touched);
+  prepared_.erase(found);
+  return {};
+}
+
+void TimelineSet::Impl::drop_prepared(TimelineSet& set, PrepareId id) {
+  const auto found = set.prepared_.find(id);
+  const PreparedSet& held = found->second;
+  TouchedSet touched;
+  for (const ItemKey& key : held.items) {
+    std::erase_if(set.timelines_[key.entity].reservations, [&](const Reservation& r) {
+      return r.prepared && r.agent == held.agent && r.route == held.route &&
+             r.step == key.step && r.origin == key.origin;
+    });
+    touched.insert(key.entity);
+  }
+  set.prepared_.erase(found);
+  std::vector<Grant> grants = grant_waiting(set, TouchedSet(touched), touched);
+  set.pending_grants_.insert(set.pending_grants_.end(), grants.begin(), grants.end());
+  bump_versions(set, touched);
+}
+
+Status TimelineSet::abort(PrepareId id) {
+  if (!prepared_.contains(id)) {
+    return fail(ErrorCode::not_found,
+                "abort: prepared set " + std::to_string(id) + " is unknown, committed or expired");
+  }
+  Impl::drop_prepared(*this, id);
+  return {};
+}
+
+std::vector<PrepareId> TimelineSet::expire(TimeNs now) {
+  std::vector<PrepareId> expired;
+  for (const auto& [id, held] : prepared_) {
+    if (held.expires_at <= now) expired.push_back(id);
+  }
+  for (PrepareId id : expired) Impl::drop_prepared(*this, id);
+  return expired;
+}
+
+std::vector<Grant> TimelineSet::take_grants() { return std::exchange(pending_grants_, {}); }
+
+Status TimelineSet::reserve(const AgentId& agent, RouteId route,
+                            const std::vector<RouteStep>& steps) {
+  if (steps.empty()) return fail(ErrorCode::invalid_argument, "reserve: the route has no steps");
+  if (agent.empty()) return fail(ErrorCode::invalid_argument, "reserve: empty agent id");
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    if (!steps[i].window.valid()) {
+      return fail(ErrorCode::invalid_argument,
+                  "reserve: step " + std::to_string(i) + " on entity " +
+                      std::to_string(steps[i].entity) + " has an empty or reversed window " +
+                      window_text(steps[i].window));
+    }
+  }
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    if (!owns(steps[i].entity)) {
+      return fail(ErrorCode::not_found, "reserve: step " + std::to_string(i) + " is on entity " +
+                                            std::to_string(steps[i].entity) +
+                                            ", which this set does not own");
+    }
+  }
+  std::vector<Reservation> items = expand(agent, route, steps);
+  std::erase_if(items, [this](const Reservation& r) { return !owns(r.entity); });
+  Result<PrepareId> prepared = prepare(items, {}, kForever);
+  if (!prepared) return unexpected(std::move(prepared).error());
+  return commit(*prepared);
+}
+
+}  // namespace drover::topology
