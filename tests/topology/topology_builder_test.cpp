@@ -246,7 +246,7 @@ TEST(TopologyBuilder, RejectsNonFiniteNumbersAndBadOptions) {
   const Diagnostics diagnostics = build_errors(std::move(builder));
   const std::string all = dump(diagnostics);
   EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.vertex_radius", "positive")) << all;
-  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.disc_points", "at least 3")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.disc_points", "between 3 and 256")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[0].x", "finite")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].y", "finite")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].restrictions.max_speed", "positive"))

@@ -46,7 +46,10 @@ class Validator {
     if (!positive_finite(options.edge_half_width)) {
       report("footprint_options.edge_half_width", "must be a positive finite number");
     }
-    if (options.disc_points < 3) report("footprint_options.disc_points", "must be at least 3");
+    if (options.disc_points < 3 || options.disc_points > kMaxDiscPoints) {
+      report("footprint_options.disc_points",
+             "must be between 3 and " + std::to_string(kMaxDiscPoints));
+    }
   }
 
   /// Registers an id; reports an empty or already used one.

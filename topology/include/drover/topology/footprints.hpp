@@ -34,6 +34,9 @@ std::optional<Polygon> edge_footprint(const Point& from, const Point& to,
                                       const Polygon& to_footprint,
                                       const FootprintOptions& options);
 
+/// The most corners a generated disc may have (more buys no accuracy, only cost).
+inline constexpr int kMaxDiscPoints = 256;
+
 /// Footprints smaller than this (m^2) are treated as empty.
 inline constexpr double kMinFootprintArea = 1e-6;
 
