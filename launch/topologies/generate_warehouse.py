@@ -19,9 +19,11 @@ The two lanes of a pair are joined both ways at every aisle, so every vertex can
 every other. Footprints are generated: 1.2 m vertex squares and 1.4 m wide edges, so two
 edges meeting at a right angle conflict (a turning vehicle sweeps the corner) while
 parallel lanes 2 m apart do not. Partitions: "west" (x < 30 m) and "east" (x >= 30 m); an edge belongs to the
-partition of its `from` vertex. Run from anywhere: it writes next to itself.
+partition of its `from` vertex. Run from anywhere: it writes warehouse.json next to
+itself (or to --output).
 """
 
+import argparse
 import json
 import os
 
@@ -165,7 +167,11 @@ def render(plan):
 
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
-    with open(os.path.join(here, "warehouse.json"), "w", encoding="utf-8") as out:
+    parser = argparse.ArgumentParser(description="Generate the bundled warehouse topology.")
+    parser.add_argument("--output", default=os.path.join(here, "warehouse.json"),
+                        help="where to write (default: warehouse.json next to this script)")
+    arguments = parser.parse_args()
+    with open(arguments.output, "w", encoding="utf-8") as out:
         out.write(render(build()))
 
 

@@ -222,6 +222,22 @@ TEST_F(TopologyValidate, BundledTopologiesAreValid) {
   EXPECT_NE(warehouse.out.find("partitions: east, west\n"), std::string::npos) << warehouse.out;
 }
 
+// The committed warehouse.json must be what its generator produces, so edits to the
+// generator are never lost or half-applied.
+TEST_F(TopologyValidate, WarehouseIsTheGeneratorsOutput) {
+  if (std::system("python3 --version >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "python3 is not installed";
+  }
+  const fs::path directory = source_dir() / "launch" / "topologies";
+  const fs::path generated = scratch_.path() / "warehouse.json";
+  const std::string command = "python3 " +
+                              shell_quote((directory / "generate_warehouse.py").string()) +
+                              " --output " + shell_quote(generated.string());
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  EXPECT_EQ(read_all(generated), read_all(directory / "warehouse.json"))
+      << "re-run launch/topologies/generate_warehouse.py and commit warehouse.json";
+}
+
 // Random bytes, with either extension: always exit 0 or 2 with messages, never a crash.
 TEST_F(TopologyValidate, RandomBytesNeverCrash) {
   std::mt19937 random(99);
