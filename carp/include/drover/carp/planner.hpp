@@ -1,0 +1,58 @@
+#pragma once
+// Context-Aware Route Planning (ter Mors et al.): the earliest-arrival route through free
+// time windows of vertices and edges, around the reservations and locks in a TimelineSet.
+
+#include <memory>
+
+#include "drover/carp/route.hpp"
+#include "drover/carp/routing_graph.hpp"
+#include "drover/topology/timeline.hpp"
+
+namespace drover::carp {
+
+struct PlannerOptions {
+  /// Routes must reach every stop within start_time + horizon (the search gives up on
+  /// later windows and reports no_window). > 0.
+  DurationNs horizon = 3600 * kNsPerSecond;
+  /// How many heuristic tables (one per goal and vehicle class) are kept between calls.
+  std::size_t heuristic_tables = 64;
+};
+
+/// The route planner of a routing agent. It keeps search memory and heuristic tables
+/// between calls, so one Planner serves many requests; it is not thread-safe (one per
+/// thread). The graph (and its topology) must outlive it.
+///
+/// Model (docs/carp.md): driving arc a takes travel(a) = length / min(vehicle max speed,
+/// speed limit of a); vertices take no time. Passing from one entity to the next, the
+/// vehicle occupies both for the clearance time length_vehicle / speed of the edge
+/// involved, so consecutive step windows overlap by it. The vehicle may wait on any
+/// entity while its free window lasts.
+class Planner {
+ public:
+  explicit Planner(std::shared_ptr<const RoutingGraph> graph, PlannerOptions options = {});
+  ~Planner();
+  Planner(Planner&&) noexcept;
+  Planner& operator=(Planner&&) noexcept;
+
+  /// A test route: plans on `timelines` and reserves nothing.
+  /// \param timelines  the timelines of every entity of the graph's topology
+  /// \return the route arriving earliest at the last stop (stops in order, each held for
+  ///         its dwell, the last one open-ended unless it has a dwell), or why there is
+  ///         none. Never an empty route.
+  Result<Route, PlanError> plan(const topology::TimelineSet& timelines,
+                                const PlanRequest& request);
+
+  /// A real route: plan() and then reserve it in `timelines` as (agent, route), all or
+  /// nothing. On error nothing is reserved.
+  Result<Route, PlanError> plan_and_reserve(topology::TimelineSet& timelines,
+                                            const PlanRequest& request,
+                                            topology::RouteId route);
+
+  const RoutingGraph& graph() const noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drover::carp

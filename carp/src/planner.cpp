@@ -1,0 +1,286 @@
+#include "drover/carp/planner.hpp"
+
+#include <deque>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "heuristic.hpp"
+#include "traversal.hpp"
+#include "window_search.hpp"
+
+namespace drover::carp {
+
+using topology::EntityIndex;
+using topology::Interval;
+using topology::TimelineSet;
+
+namespace {
+
+/// Times beyond this are refused, so that sums of times never overflow.
+constexpr TimeNs kLatestTime = kForever / 4;
+constexpr std::size_t kVehicleClasses = 8;
+
+std::string time_text(TimeNs t) {
+  return t == kForever ? std::string("forever") : fmt::format("{:.3f} s", ns_to_seconds(t));
+}
+
+PlanError error(PlanFailure reason, std::string message) {
+  return PlanError{reason, std::move(message)};
+}
+
+/// What keeps `agent` off `entity` at time t: a lock or another agent's reservation on the
+/// entity or its conflict set (the blockers of TimelineSet::free_windows).
+std::string blocker_text(const topology::Topology& topology, const TimelineSet& timelines,
+                         EntityIndex entity, std::string_view agent, TimeNs t) {
+  std::vector<EntityIndex> places{entity};
+  places.insert(places.end(), topology.conflicts(entity).begin(),
+                topology.conflicts(entity).end());
+  for (const EntityIndex place : places) {
+    if (!timelines.owns(place)) continue;
+    const topology::Timeline& timeline = timelines.timeline(place);
+    for (const topology::Lock& lock : timeline.locks) {
+      if (lock.window.contains(t)) {
+        return fmt::format("lock {} on '{}' [{}, {}) by {}: {}", lock.id, topology.id(place),
+                           time_text(lock.window.start), time_text(lock.window.end),
+                           lock.operator_id, lock.reason);
+      }
+    }
+    for (const topology::Reservation& r : timeline.reservations) {
+      if (r.agent != agent && r.window.contains(t)) {
+        return fmt::format("agent {} route {} holds '{}'{} [{}, {})", r.agent, r.route,
+                           topology.id(r.origin),
+                           r.shadow() ? fmt::format(" (conflicting with '{}')", topology.id(place))
+                                      : std::string(),
+                           time_text(r.window.start), time_text(r.window.end));
+      }
+    }
+  }
+  return "another agent's allocation there (nobody may come before a holder)";
+}
+
+/// True when some path leads from `from` to `to`, whatever the vehicle.
+bool connected(const RoutingGraph& graph, EntityIndex from, EntityIndex to) {
+  std::vector<std::uint8_t> seen(graph.vertex_count(), 0);
+  std::deque<EntityIndex> queue{from};
+  seen[from] = 1;
+  while (!queue.empty()) {
+    const EntityIndex v = queue.front();
+    queue.pop_front();
+    if (v == to) return true;
+    for (ArcIndex a = graph.arcs_begin(v); a != graph.arcs_end(v); ++a) {
+      const EntityIndex next = graph.arc(a).to;
+      if (!seen[next]) {
+        seen[next] = 1;
+        queue.push_back(next);
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+struct Planner::Impl {
+  std::shared_ptr<const RoutingGraph> graph;
+  PlannerOptions options;
+  TraversalCache traversals{kVehicleClasses};
+  HeuristicCache heuristics;
+  WindowSearch search;
+  std::vector<Leg> legs;
+
+  Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
+      : graph(std::move(g)), options(o), heuristics(o.heuristic_tables) {}
+
+  const topology::Topology& topology() const { return graph->topology(); }
+
+  std::string vertex_name(EntityIndex v) const { return "'" + topology().id(v) + "'"; }
+
+  std::optional<PlanError> check_request(const TimelineSet& timelines,
+                                         const PlanRequest& request) const {
+    const auto invalid = [](std::string message) {
+      return error(PlanFailure::invalid_request, std::move(message));
+    };
+    if (options.horizon <= 0) return invalid("the planner's horizon must be > 0");
+    if (request.agent.empty()) return invalid("the agent id is empty");
+    if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
+    if (timelines.entity_count() != topology().entity_count()) {
+      return invalid(fmt::format("the timelines cover {} entities, topology '{}' has {}",
+                                 timelines.entity_count(), topology().name(),
+                                 topology().entity_count()));
+    }
+    const auto not_vertex = [&](EntityIndex v, const std::string& what) {
+      return invalid(fmt::format("{}: entity {} is not a vertex of topology '{}' ({} vertices)",
+                                 what, v, topology().name(), topology().vertex_count()));
+    };
+    if (request.start >= topology().vertex_count()) return not_vertex(request.start, "start");
+    if (request.start_time < 0 || request.start_time > kLatestTime) {
+      return invalid(fmt::format("start time {} ns is out of range", request.start_time));
+    }
+    if (request.stops.empty()) return invalid("the request has no stops");
+    for (std::size_t k = 0; k < request.stops.size(); ++k) {
+      const Stop& stop = request.stops[k];
+      const std::string what = fmt::format("stop {}", k);
+      if (stop.vertex >= topology().vertex_count()) return not_vertex(stop.vertex, what);
+      if (!stop.dwell) continue;
+      const bool last = k + 1 == request.stops.size();
+      if (*stop.dwell < 0 || (last && *stop.dwell == 0) || *stop.dwell > kLatestTime) {
+        return invalid(fmt::format("{} ({}): dwell {} ns must be {} (and not huge)", what,
+                                   vertex_name(stop.vertex), *stop.dwell,
+                                   last ? "> 0 for the last stop, or absent for an open-ended hold"
+                                        : ">= 0"));
+      }
+    }
+    return std::nullopt;
+  }
+
+  std::optional<PlanError> check_usable(const Traversal& traversal,
+                                        const PlanRequest& request) const {
+    const auto check = [&](EntityIndex v, const std::string& what) -> std::optional<PlanError> {
+      if (traversal.usable_vertex(v)) return std::nullopt;
+      return error(PlanFailure::restricted,
+                   fmt::format("vehicle '{}' may not use {} {}: {}", request.vehicle.id, what,
+                               vertex_name(v),
+                               *restriction_violation(topology().vertex(v).restrictions,
+                                                      request.vehicle)));
+    };
+    if (auto bad = check(request.start, "start vertex")) return bad;
+    for (std::size_t k = 0; k < request.stops.size(); ++k) {
+      if (auto bad = check(request.stops[k].vertex, fmt::format("stop {}", k))) return bad;
+    }
+    return std::nullopt;
+  }
+
+  /// Sets up one leg per stop with its heuristic table, or says why a stop is out of reach.
+  std::optional<PlanError> prepare_legs(const Traversal& traversal, std::uint64_t class_id,
+                                        const PlanRequest& request) {
+    heuristics.next_request();
+    const std::size_t count = request.stops.size();
+    legs.resize(count);
+    std::vector<DurationNs> leg_time(count);
+    for (std::size_t k = 0; k < count; ++k) {
+      const EntityIndex from = k == 0 ? request.start : request.stops[k - 1].vertex;
+      const EntityIndex to = request.stops[k].vertex;
+      Leg& leg = legs[k];
+      leg.stop = to;
+      leg.dwell = request.stops[k].dwell.value_or(k + 1 == count ? kForever : 0);
+      leg.table = &heuristics.table(*graph, class_id, to);
+      leg.table->aim(*graph, traversal, from);
+      leg_time[k] = leg.table->distance(*graph, traversal, from);
+      if (leg_time[k] == kUnreachable) {
+        if (connected(*graph, from, to)) {
+          return error(PlanFailure::restricted,
+                       fmt::format("every path from {} to {} (stop {}) uses an entity vehicle "
+                                   "'{}' may not use (type, payload or size)",
+                                   vertex_name(from), vertex_name(to), k, request.vehicle.id));
+        }
+        return error(PlanFailure::unreachable,
+                     fmt::format("no path leads from {} to {} (stop {}) in topology '{}'",
+                                 vertex_name(from), vertex_name(to), k, topology().name()));
+      }
+    }
+    legs[count - 1].tail = 0;
+    for (std::size_t k = count - 1; k-- > 0;) {
+      legs[k].tail = legs[k].dwell + leg_time[k + 1] + legs[k + 1].tail;
+    }
+    return std::nullopt;
+  }
+
+  /// Explains a search that found nothing (only called then, so it may take its time).
+  PlanError diagnose(const TimelineSet& timelines, const PlanRequest& request,
+                     SearchInput input, const SearchOutcome& outcome) {
+    const std::string& agent = request.agent;
+    std::vector<Interval> with_locks, without_locks;
+    if (!outcome.start_free) {
+      timelines.append_free_windows(request.start, agent, request.start_time,
+                                    request.start_time + 1, without_locks, false);
+      const std::string why = blocker_text(topology(), timelines, request.start, agent,
+                                           request.start_time);
+      return error(without_locks.empty() ? PlanFailure::no_window : PlanFailure::locked,
+                   fmt::format("start vertex {} is not free at {}: {}",
+                               vertex_name(request.start), time_text(request.start_time), why));
+    }
+    const EntityIndex goal = request.stops.back().vertex;
+    if (!request.stops.back().dwell) {
+      const auto open_ended = [](const std::vector<Interval>& windows) {
+        return !windows.empty() && windows.back().end == kForever;
+      };
+      timelines.append_free_windows(goal, agent, request.start_time, kForever, with_locks);
+      timelines.append_free_windows(goal, agent, request.start_time, kForever, without_locks,
+                                    false);
+      if (!open_ended(with_locks)) {
+        const TimeNs from = with_locks.empty() ? request.start_time : with_locks.back().end;
+        return error(open_ended(without_locks) ? PlanFailure::locked : PlanFailure::no_window,
+                     fmt::format("the last stop {} is never free for good (open-ended) from "
+                                 "{} on: {}",
+                                 vertex_name(goal), time_text(from),
+                                 blocker_text(topology(), timelines, goal, agent, from)));
+      }
+    }
+    input.count_locks = false;
+    if (search.run(input).found) {
+      return error(PlanFailure::locked,
+                   fmt::format("locks block every route to {}; without them it would arrive "
+                               "at {}",
+                               vertex_name(goal), time_text(search.route(input).arrival)));
+    }
+    if (outcome.horizon_cut) {
+      return error(PlanFailure::no_window,
+                   fmt::format("no sequence of free windows reaches {} within the horizon of "
+                               "{} after {}",
+                               vertex_name(goal), time_text(options.horizon),
+                               time_text(request.start_time)));
+    }
+    return error(PlanFailure::no_window,
+                 fmt::format("other agents' reservations block every route to {} for good",
+                             vertex_name(goal)));
+  }
+
+  Result<Route, PlanError> plan(const TimelineSet& timelines, const PlanRequest& request) {
+    if (auto bad = check_request(timelines, request)) return unexpected(std::move(*bad));
+    const auto [traversal, class_id] = traversals.get(*graph, request.vehicle);
+    if (auto bad = check_usable(*traversal, request)) return unexpected(std::move(*bad));
+    if (auto bad = prepare_legs(*traversal, class_id, request)) {
+      return unexpected(std::move(*bad));
+    }
+    SearchInput input;
+    input.graph = graph.get();
+    input.traversal = traversal;
+    input.timelines = &timelines;
+    input.agent = request.agent;
+    input.start = request.start;
+    input.start_time = request.start_time;
+    input.legs = legs;
+    input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
+    const SearchOutcome outcome = search.run(input);
+    if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));
+    return search.route(input);
+  }
+};
+
+Planner::Planner(std::shared_ptr<const RoutingGraph> graph, PlannerOptions options)
+    : impl_(std::make_unique<Impl>(std::move(graph), options)) {}
+Planner::~Planner() = default;
+Planner::Planner(Planner&&) noexcept = default;
+Planner& Planner::operator=(Planner&&) noexcept = default;
+
+const RoutingGraph& Planner::graph() const noexcept { return *impl_->graph; }
+
+Result<Route, PlanError> Planner::plan(const TimelineSet& timelines, const PlanRequest& request) {
+  return impl_->plan(timelines, request);
+}
+
+Result<Route, PlanError> Planner::plan_and_reserve(TimelineSet& timelines,
+                                                   const PlanRequest& request,
+                                                   topology::RouteId route) {
+  auto planned = impl_->plan(timelines, request);
+  if (!planned) return planned;
+  if (auto reserved = timelines.reserve(request.agent, route, planned->steps); !reserved) {
+    return unexpected(error(PlanFailure::conflict,
+                            fmt::format("route {} of agent {} was planned but not reserved: {}",
+                                        route, request.agent, reserved.error().message)));
+  }
+  return planned;
+}
+
+}  // namespace drover::carp

@@ -1,0 +1,67 @@
+#include "traversal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace drover::carp {
+
+using topology::EntityIndex;
+
+Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
+    : vehicle_(vehicle) {
+  const topology::Topology& topology = graph.topology();
+  usable_vertex_.resize(graph.vertex_count());
+  for (EntityIndex v = 0; v < graph.vertex_count(); ++v) {
+    usable_vertex_[v] = !restriction_violation(topology.vertex(v).restrictions, vehicle);
+  }
+  const std::size_t arcs = graph.arc_count();
+  travel_.resize(arcs);
+  clearance_.resize(arcs);
+  usable_arc_.resize(arcs);
+  double ns_per_metre = std::numeric_limits<double>::infinity();
+  for (ArcIndex a = 0; a < arcs; ++a) {
+    const Arc& arc = graph.arc(a);
+    const double speed = std::min(vehicle.max_speed, arc.speed_limit);
+    travel_[a] = std::max<DurationNs>(1, std::llround(arc.length / speed * 1e9));
+    clearance_[a] = std::max<DurationNs>(1, static_cast<DurationNs>(
+                                                std::ceil(vehicle.length / speed * 1e9)));
+    usable_arc_[a] = usable_vertex_[arc.to] &&
+                     !restriction_violation(topology.edge(arc.edge).restrictions, vehicle);
+    const double straight = graph.straight_distance(arc.from, arc.to);
+    if (straight > 0) {
+      ns_per_metre = std::min(ns_per_metre, static_cast<double>(travel_[a]) / straight);
+    }
+  }
+  // Shrunk a little so that floating-point error in the triangle inequality can never make
+  // the bound inconsistent by a nanosecond.
+  ns_per_metre_ = std::isfinite(ns_per_metre) ? ns_per_metre * (1 - 1e-9) : 0;
+}
+
+bool Traversal::same_class(const VehicleProfile& a, const VehicleProfile& b) {
+  return a.max_speed == b.max_speed && a.length == b.length && a.width == b.width &&
+         a.payload == b.payload && a.type == b.type;
+}
+
+TraversalCache::Found TraversalCache::get(const RoutingGraph& graph,
+                                          const VehicleProfile& vehicle) {
+  ++clock_;
+  for (Entry& entry : entries_) {
+    if (Traversal::same_class(entry.traversal->vehicle(), vehicle)) {
+      entry.last_used = clock_;
+      return {entry.traversal.get(), entry.class_id};
+    }
+  }
+  Entry fresh{std::make_unique<Traversal>(graph, vehicle), next_class_id_++, clock_};
+  const Found found{fresh.traversal.get(), fresh.class_id};
+  if (entries_.size() < capacity_) {
+    entries_.push_back(std::move(fresh));
+  } else {
+    *std::min_element(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
+      return a.last_used < b.last_used;
+    }) = std::move(fresh);
+  }
+  return found;
+}
+
+}  // namespace drover::carp

@@ -1,0 +1,79 @@
+#pragma once
+// What the routing graph means for one vehicle class: travel and clearance times per arc,
+// and which vertices and arcs it may use. Computed once per class and cached.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "drover/carp/routing_graph.hpp"
+#include "drover/carp/vehicle.hpp"
+#include "drover/common/clock.hpp"
+
+namespace drover::carp {
+
+/// "Never": the travel time of an unreachable vertex.
+inline constexpr DurationNs kUnreachable = kForever;
+
+class Traversal {
+ public:
+  Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle);
+
+  /// True when two profiles drive the graph alike (same speed, type, size and payload).
+  static bool same_class(const VehicleProfile& a, const VehicleProfile& b);
+
+  /// Time to drive the arc: length / min(max speed, arc speed limit), rounded to the
+  /// nearest ns and at least 1 ns.
+  DurationNs travel(ArcIndex arc) const { return travel_[arc]; }
+  /// How long the vehicle spans an end vertex and the arc while passing between them:
+  /// vehicle length / the same speed, rounded up.
+  DurationNs clearance(ArcIndex arc) const { return clearance_[arc]; }
+  bool usable_vertex(topology::EntityIndex vertex) const { return usable_vertex_[vertex] != 0; }
+  /// The vehicle may drive the arc: its edge and its destination vertex allow it.
+  bool usable_arc(ArcIndex arc) const { return usable_arc_[arc] != 0; }
+
+  /// A lower bound of the travel time between two vertices, consistent with travel():
+  /// lower_bound(a, c) <= travel(arc a->b) + lower_bound(b, c) for every arc.
+  DurationNs lower_bound(const RoutingGraph& graph, topology::EntityIndex a,
+                         topology::EntityIndex b) const {
+    return static_cast<DurationNs>(ns_per_metre_ * graph.straight_distance(a, b));
+  }
+
+  const VehicleProfile& vehicle() const noexcept { return vehicle_; }
+
+ private:
+  VehicleProfile vehicle_;
+  std::vector<DurationNs> travel_;
+  std::vector<DurationNs> clearance_;
+  std::vector<std::uint8_t> usable_vertex_;
+  std::vector<std::uint8_t> usable_arc_;
+  double ns_per_metre_ = 0;
+};
+
+/// The traversals of the vehicle classes seen lately (least recently used dropped first).
+/// Each class gets a unique id, never reused, that keys its heuristic tables.
+class TraversalCache {
+ public:
+  explicit TraversalCache(std::size_t capacity) : capacity_(capacity < 1 ? 1 : capacity) {}
+
+  struct Found {
+    const Traversal* traversal;
+    std::uint64_t class_id;
+  };
+  /// The traversal of the vehicle's class, built on first use. Stays valid until `capacity`
+  /// other classes have been asked for.
+  Found get(const RoutingGraph& graph, const VehicleProfile& vehicle);
+
+ private:
+  struct Entry {
+    std::unique_ptr<Traversal> traversal;
+    std::uint64_t class_id = 0;
+    std::uint64_t last_used = 0;
+  };
+  std::size_t capacity_;
+  std::vector<Entry> entries_;
+  std::uint64_t next_class_id_ = 1;
+  std::uint64_t clock_ = 0;
+};
+
+}  // namespace drover::carp

@@ -1,0 +1,307 @@
+// Randomised guarantees of the CARP planner (fixed seeds): on small random graphs with random
+// reservations of other agents and random locks, every route is valid and collision-free
+// (route_checks.hpp), is accepted by TimelineSet::reserve, and arrives exactly when a
+// brute-force time-expanded search says the earliest arrival is. All lengths, speeds and
+// times are whole seconds, so the brute force on a one-second grid is exact.
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "drover/carp/planner.hpp"
+#include "grid_builder.hpp"
+#include "route_checks.hpp"
+
+namespace drover::carp::test {
+namespace {
+
+using topology::EntityIndex;
+using topology::Topology;
+
+constexpr int kNever = std::numeric_limits<int>::max();
+constexpr int kGrid = 200;  // brute-force time grid: [0, kGrid) seconds
+
+/// A reservation of another agent, or a lock, in whole seconds (end kNever: open-ended).
+struct Blocker {
+  EntityIndex entity;
+  int start;
+  int end;
+  bool lock;
+};
+
+/// When a reservation of `g` keeps another agent off `e`: the TimelineSet rule that items
+/// (real or shadow) of different agents never overlap on one timeline, so a reservation of
+/// g (which writes items on g and C(g)) blocks e (which needs e and C(e)) when the two sets
+/// meet. A lock on x blocks e when x is e or in C(e).
+bool reservation_blocks(const Topology& t, EntityIndex g, EntityIndex e) {
+  const auto with_self = [&t](EntityIndex x) {
+    std::vector<EntityIndex> set(t.conflicts(x).begin(), t.conflicts(x).end());
+    set.push_back(x);
+    std::sort(set.begin(), set.end());
+    return set;
+  };
+  const auto a = with_self(g);
+  const auto b = with_self(e);
+  std::vector<EntityIndex> common;
+  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+  return !common.empty();
+}
+bool lock_blocks(const Topology& t, EntityIndex x, EntityIndex e) {
+  const auto c = t.conflicts(e);
+  return x == e || std::find(c.begin(), c.end(), x) != c.end();
+}
+
+/// Earliest arrival by exhaustive search over (stop layer, node, entry second), where a
+/// node is a vertex or an edge driven in one direction. Independent of the planner: built
+/// from the Topology and the blockers only.
+class BruteForce {
+ public:
+  BruteForce(const Topology& t, const std::vector<Blocker>& blockers, const PlanRequest& request)
+      : t_(t), request_(request) {
+    const std::size_t entities = t.entity_count();
+    blocked_prefix_.assign(entities, std::vector<int>(kGrid + 1, 0));
+    forever_from_.assign(entities, kNever);
+    for (EntityIndex e = 0; e < entities; ++e) {
+      std::vector<int> slot(kGrid, 0);
+      for (const Blocker& b : blockers) {
+        if (!(b.lock ? lock_blocks(t, b.entity, e) : reservation_blocks(t, b.entity, e))) continue;
+        for (int s = b.start; s < std::min(b.end, kGrid); ++s) slot[s] = 1;
+        if (b.end == kNever) forever_from_[e] = std::min(forever_from_[e], b.start);
+      }
+      for (int s = 0; s < kGrid; ++s) blocked_prefix_[e][s + 1] = blocked_prefix_[e][s] + slot[s];
+    }
+    for (EntityIndex v = 0; v < t.vertex_count(); ++v) {
+      for (const topology::Move& m : t.moves_from(v)) {
+        if (restriction_violation(t.edge(m.edge).restrictions, request.vehicle) ||
+            restriction_violation(t.vertex(m.to).restrictions, request.vehicle)) {
+          continue;
+        }
+        const double speed = edge_speed(t, m.edge, request.vehicle);
+        arcs_.push_back(ArcInfo{v, m.to, m.edge,
+                                static_cast<int>(std::lround(t.edge(m.edge).length / speed)),
+                                static_cast<int>(std::lround(request.vehicle.length / speed))});
+      }
+    }
+  }
+
+  /// The earliest arrival in seconds, or nullopt when none exists on the grid.
+  std::optional<int> earliest_arrival() {
+    const std::size_t layers = request_.stops.size();
+    const std::size_t vertices = t_.vertex_count();
+    const std::size_t nodes = vertices + arcs_.size();
+    best_.assign(layers * nodes * kGrid, kNever);
+    const auto at = [&](std::size_t k, std::size_t n, int x) -> int& {
+      return best_[(k * nodes + n) * kGrid + x];
+    };
+    if (restriction_violation(t_.vertex(request_.start).restrictions, request_.vehicle)) {
+      return std::nullopt;
+    }
+    at(0, request_.start, 0) = 0;
+    std::optional<int> arrival;
+    for (int x = 0; x < kGrid; ++x) {
+      for (std::size_t k = 0; k < layers; ++k) {
+        const Stop& stop = request_.stops[k];
+        const int dwell = static_cast<int>(stop.dwell.value_or(0) / kNsPerSecond);
+        for (std::size_t n = 0; n < nodes; ++n) {
+          const int ready = at(k, n, x);
+          if (ready == kNever) continue;
+          if (n < vertices) {
+            const auto v = static_cast<EntityIndex>(n);
+            if (v == stop.vertex &&
+                !restriction_violation(t_.vertex(v).restrictions, request_.vehicle)) {
+              if (k + 1 == layers) {
+                const bool held = stop.dwell ? free(v, x, ready + dwell) : free(v, x, kNever);
+                if (held && (!arrival || ready < *arrival)) arrival = ready;
+              } else if (ready + dwell < kGrid) {
+                int& next = at(k + 1, n, x);
+                next = std::min(next, ready + dwell);
+              }
+            }
+            for (std::size_t a = 0; a < arcs_.size(); ++a) {
+              if (arcs_[a].from != v) continue;
+              for (int y = ready; y < kGrid && free(v, x, y + arcs_[a].clearance); ++y) {
+                int& next = at(k, vertices + a, y);
+                next = std::min(next, y + arcs_[a].travel);
+              }
+            }
+          } else {
+            const ArcInfo& arc = arcs_[n - vertices];
+            for (int y = ready; y < kGrid && free(arc.edge, x, y + arc.clearance); ++y) {
+              int& next = at(k, arc.to, y);
+              next = std::min(next, y);
+            }
+          }
+        }
+      }
+    }
+    return arrival;
+  }
+
+ private:
+  struct ArcInfo {
+    EntityIndex from, to, edge;
+    int travel, clearance;
+  };
+  /// True when e is free for the whole of [from, until) (until kNever: for good).
+  bool free(EntityIndex e, int from, int until) const {
+    if (until == kNever && forever_from_[e] != kNever) return false;
+    const int end = std::min(until, kGrid);
+    return from >= end || blocked_prefix_[e][end] == blocked_prefix_[e][from];
+  }
+
+  const Topology& t_;
+  const PlanRequest& request_;
+  std::vector<std::vector<int>> blocked_prefix_;
+  std::vector<int> forever_from_;
+  std::vector<ArcInfo> arcs_;
+  std::vector<int> best_;
+};
+
+/// A random grid of up to 5 x 5 cells with random lengths, slow edges, one-way edges, a few
+/// diagonals (which cross) and a few edges closed to the test vehicle's type.
+Topology random_grid(std::mt19937& rng) {
+  std::uniform_int_distribution<int> size(2, 5);
+  std::uniform_real_distribution<double> coin(0, 1);
+  const int width = size(rng), height = size(rng);
+  std::vector<std::vector<bool>> present(width, std::vector<bool>(height));
+  GridBuilder g;
+  for (int x = 0; x < width; ++x) {
+    for (int y = 0; y < height; ++y) {
+      present[x][y] = coin(rng) < 0.85 || (x == 0 && y == 0) || (x == 1 && y == 0);
+      if (present[x][y]) g.cell(x, y);
+    }
+  }
+  const auto maybe_edge = [&](int x1, int y1, int x2, int y2, double probability) {
+    if (x2 >= width || y2 >= height || !present[x1][y1] || !present[x2][y2]) return;
+    if (coin(rng) >= probability) return;
+    EdgeOptions options;
+    options.length = std::uniform_int_distribution<int>(1, 3)(rng);
+    options.max_speed = coin(rng) < 0.2 ? 0.5 : 1.0;
+    if (coin(rng) < 0.1) {
+      options.bidirectional = false;
+      if (coin(rng) < 0.5) {
+        std::swap(x1, x2);
+        std::swap(y1, y2);
+      }
+    }
+    if (coin(rng) < 0.04) options.restrictions.forbidden_vehicle_types = {"agv"};
+    g.edge(x1, y1, x2, y2, options);
+  };
+  for (int x = 0; x < width; ++x) {
+    for (int y = 0; y < height; ++y) {
+      maybe_edge(x, y, x + 1, y, 0.9);
+      maybe_edge(x, y, x, y + 1, 0.9);
+      maybe_edge(x, y, x + 1, y + 1, 0.1);
+    }
+  }
+  return std::move(g).build();
+}
+
+/// Fills the timelines with random reservations of agents b, c, d (and a few of a's own,
+/// which must not matter) and random locks; returns what blocks agent a.
+std::vector<Blocker> random_traffic(World& w, std::mt19937& rng) {
+  std::uniform_real_distribution<double> coin(0, 1);
+  std::uniform_int_distribution<EntityIndex> entity(
+      0, static_cast<EntityIndex>(w.topology.entity_count() - 1));
+  std::uniform_int_distribution<int> start(0, 50), length(1, 8);
+  std::vector<Blocker> blockers;
+  for (const char* agent : {"b", "c", "d", "a"}) {
+    const int attempts = 2;
+    for (int i = 0; i < attempts; ++i) {
+      const EntityIndex e = entity(rng);
+      const int from = start(rng);
+      const int until = coin(rng) < 0.03 ? kNever : from + length(rng);
+      const topology::Interval window{sec(from), until == kNever ? kForever : sec(until)};
+      if (w.timelines.reserve(agent, w.next_route++, {{e, window}}) && agent[0] != 'a') {
+        blockers.push_back(Blocker{e, from, until, false});
+      }
+    }
+  }
+  if (coin(rng) < 0.3) {
+    const EntityIndex e = entity(rng);
+    const int from = start(rng);
+    const int until = coin(rng) < 0.1 ? kNever : from + length(rng);
+    const topology::Interval window{sec(from), until == kNever ? kForever : sec(until)};
+    if (w.timelines.lock(e, window, "operator", "random")) {
+      blockers.push_back(Blocker{e, from, until, true});
+    }
+  }
+  return blockers;
+}
+
+PlanRequest random_request(const World& w, std::mt19937& rng) {
+  std::uniform_real_distribution<double> coin(0, 1);
+  std::uniform_int_distribution<EntityIndex> vertex(
+      0, static_cast<EntityIndex>(w.topology.vertex_count() - 1));
+  PlanRequest request;
+  request.agent = "a";
+  request.vehicle = unit_vehicle();
+  request.vehicle.length = coin(rng) < 0.3 ? 2.0 : 1.0;
+  request.start = vertex(rng);
+  const double draw = coin(rng);
+  const int stops = draw < 0.6 ? 1 : draw < 0.9 ? 2 : 3;
+  for (int k = 0; k < stops; ++k) {
+    Stop stop{vertex(rng), std::nullopt};
+    if (k + 1 < stops) {
+      stop.dwell = sec(std::uniform_int_distribution<int>(0, 3)(rng));
+    } else if (coin(rng) < 0.3) {
+      stop.dwell = sec(std::uniform_int_distribution<int>(1, 4)(rng));
+    }
+    request.stops.push_back(stop);
+  }
+  return request;
+}
+
+TEST(PlannerRandom, RoutesAreValidCollisionFreeAndArriveAtTheEarliestPossibleTime) {
+  std::mt19937 rng(20240611);
+  int found = 0, refused = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    World w(random_grid(rng), PlannerOptions{.horizon = sec(1000)});
+    const std::vector<Blocker> blockers = random_traffic(w, rng);
+    const PlanRequest request = random_request(w, rng);
+    const auto expected = BruteForce(w.topology, blockers, request).earliest_arrival();
+    const auto planned = w.planner.plan(w.timelines, request);
+    ASSERT_EQ(planned.has_value(), expected.has_value())
+        << (planned ? "planned, the brute force found nothing"
+                    : "refused (" + planned.error().message + "), the brute force arrives at " +
+                          std::to_string(*expected) + " s");
+    if (!planned) {
+      ++refused;
+      continue;
+    }
+    ++found;
+    EXPECT_EQ(planned->arrival, sec(*expected));
+    ASSERT_TRUE(check_route(w.topology, w.timelines, request, *planned));
+    topology::TimelineSet copy = w.timelines;
+    const auto reserved = copy.reserve(request.agent, 1, planned->steps);
+    EXPECT_TRUE(reserved.has_value()) << reserved.error().message;
+  }
+  // Both outcomes must be well represented for the test to mean something.
+  EXPECT_GT(found, 150);
+  EXPECT_GT(refused, 20);
+}
+
+TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {
+  std::mt19937 rng(77);
+  for (int trial = 0; trial < 30; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    World w(random_grid(rng));
+    std::vector<std::pair<PlanRequest, Route>> routes;
+    for (int agent = 0; agent < 6; ++agent) {
+      PlanRequest request = random_request(w, rng);
+      request.agent = "agent" + std::to_string(agent);
+      request.start_time = sec(std::uniform_int_distribution<int>(0, 10)(rng));
+      auto planned = w.planner.plan_and_reserve(w.timelines, request, 1);
+      if (planned) routes.emplace_back(request, *planned);
+    }
+    // Checked at the end, against everything reserved after each route too.
+    for (const auto& [request, route] : routes) {
+      ASSERT_TRUE(check_route(w.topology, w.timelines, request, route)) << request.agent;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace drover::carp::test

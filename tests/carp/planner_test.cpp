@@ -1,0 +1,350 @@
+// Unit tests of the CARP planner: timing model, waiting, speeds, restrictions, locks,
+// stops and dwells, errors, test and real routes.
+
+#include <gtest/gtest.h>
+
+#include "drover/carp/planner.hpp"
+#include "grid_builder.hpp"
+#include "route_checks.hpp"
+
+namespace drover::carp::test {
+namespace {
+
+using topology::Interval;
+using topology::RouteStep;
+
+Stop open_stop(const World& w, const std::string& id) { return Stop{w.at(id), std::nullopt}; }
+Stop dwell_stop(const World& w, const std::string& id, double seconds) {
+  return Stop{w.at(id), sec(seconds)};
+}
+
+Route plan_ok(World& w, const PlanRequest& request) {
+  auto planned = w.planner.plan(w.timelines, request);
+  EXPECT_TRUE(planned.has_value()) << (planned ? "" : planned.error().message);
+  if (!planned) return {};
+  check_route(w.topology, w.timelines, request, *planned);
+  return *planned;
+}
+
+PlanError plan_error(World& w, const PlanRequest& request) {
+  auto planned = w.planner.plan(w.timelines, request);
+  EXPECT_FALSE(planned.has_value());
+  if (planned) return {};
+  EXPECT_FALSE(planned.error().message.empty());
+  return planned.error();
+}
+
+TEST(Planner, EmptyCorridorWindowsOverlapByTheClearanceTime) {
+  World w(GridBuilder().corridor(5).build());
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  const std::vector<RouteStep> expected{
+      {w.at("0,0"), {sec(0), sec(1)}},     {w.at("0,0-1,0"), {sec(0), sec(2)}},
+      {w.at("1,0"), {sec(1), sec(2)}},     {w.at("1,0-2,0"), {sec(1), sec(3)}},
+      {w.at("2,0"), {sec(2), sec(3)}},     {w.at("2,0-3,0"), {sec(2), sec(4)}},
+      {w.at("3,0"), {sec(3), sec(4)}},     {w.at("3,0-4,0"), {sec(3), sec(5)}},
+      {w.at("4,0"), {sec(4), kForever}},
+  };
+  EXPECT_EQ(route.steps, expected);
+  EXPECT_EQ(route.arrival, sec(4));
+  EXPECT_EQ(route.travel_time, sec(4));
+  EXPECT_DOUBLE_EQ(route.distance, 4.0);
+}
+
+TEST(Planner, StartTimeShiftsEverything) {
+  World w(GridBuilder().corridor(3).build());
+  const Route route = plan_ok(w, request_to(w, "a", "2,0", {open_stop(w, "0,0")}, sec(100)));
+  EXPECT_EQ(route.arrival, sec(102));
+  EXPECT_EQ(route.travel_time, sec(2));
+}
+
+TEST(Planner, WaitsUntilAnotherAgentsReservationIsOver) {
+  World w(GridBuilder().corridor(5).build());
+  w.occupy("b", "2,0", sec(0), sec(5));
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  // 2,0 and the edges touching it are free from 5 s on: 2,0 at 6 s at the earliest
+  // (the edge into it is held 1 s before), then two more cells.
+  EXPECT_EQ(route.arrival, sec(8));
+}
+
+TEST(Planner, TheAgentsOwnReservationsNeverBlockIt) {
+  World w(GridBuilder().corridor(5).build());
+  w.occupy("a", "2,0", sec(0), sec(50));
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(route.arrival, sec(4));
+}
+
+TEST(Planner, TakesTheFasterDetourWhenWaitingIsSlower) {
+  // Two rows of five cells joined at both ends: straight along y = 0 (4 cells) or round
+  // through y = 1 (6 cells). Blocking the straight way for 10 s makes the detour faster.
+  GridBuilder g;
+  for (int x = 0; x < 5; ++x) g.cell(x, 0).cell(x, 1);
+  for (int x = 0; x + 1 < 5; ++x) g.edge(x, 0, x + 1, 0).edge(x, 1, x + 1, 1);
+  g.edge(0, 0, 0, 1).edge(4, 0, 4, 1);
+  World w(std::move(g).build());
+  w.occupy("b", "2,0", sec(0), sec(10));
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(route.arrival, sec(6));
+  for (const auto& step : route.steps) EXPECT_NE(step.entity, w.at("2,0"));
+}
+
+TEST(Planner, DrivesEachEdgeAtTheLowestApplicableSpeed) {
+  GridBuilder g;
+  g.cell(0, 0).cell(1, 0).cell(2, 0);
+  topology::Restrictions slow_vertex;
+  slow_vertex.max_speed = 0.25;
+  g.cell(3, 0, slow_vertex);
+  topology::Restrictions slow_edge;
+  slow_edge.max_speed = 0.5;
+  g.edge(0, 0, 1, 0, {.length = 2, .max_speed = 4})                // vehicle: 2 m/s -> 1 s
+      .edge(1, 0, 2, 0, {.length = 1, .max_speed = 4, .restrictions = slow_edge})  // 2 s
+      .edge(2, 0, 3, 0, {.length = 1, .max_speed = 4});  // vertex limit 0.25 -> 4 s
+  World w(std::move(g).build());
+  PlanRequest request = request_to(w, "a", "0,0", {open_stop(w, "3,0")});
+  request.vehicle.max_speed = 2;
+  const Route route = plan_ok(w, request);
+  EXPECT_EQ(route.arrival, sec(7));
+  // The clearance follows the speed too: 1 m at 0.25 m/s spans 4 s.
+  EXPECT_EQ(route.steps[4].window, (Interval{sec(3), sec(3) + sec(4)}));
+}
+
+TEST(Planner, RestrictionsForceADetour) {
+  GridBuilder g;
+  for (int x = 0; x < 3; ++x) g.cell(x, 0).cell(x, 1);
+  topology::Restrictions no_agv;
+  no_agv.forbidden_vehicle_types = {"agv"};
+  g.edge(0, 0, 1, 0).edge(1, 0, 2, 0, {.restrictions = no_agv}).edge(0, 1, 1, 1).edge(1, 1, 2, 1);
+  g.edge(0, 0, 0, 1).edge(1, 0, 1, 1).edge(2, 0, 2, 1);
+  World w(std::move(g).build());
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+  for (const auto& step : route.steps) EXPECT_NE(step.entity, w.at("1,0-2,0"));
+  EXPECT_EQ(route.arrival, sec(4));
+
+  PlanRequest forklift = request_to(w, "f", "0,0", {open_stop(w, "2,0")});
+  forklift.vehicle.type = "forklift";
+  EXPECT_EQ(plan_ok(w, forklift).arrival, sec(2));
+}
+
+TEST(Planner, ReportsRestrictedWhenNoUsablePathOrStopExists) {
+  struct Case {
+    const char* name;
+    topology::Restrictions on_edge;
+    topology::Restrictions on_goal;
+  };
+  topology::Restrictions only_people;
+  only_people.allowed_vehicle_types = {"person"};
+  topology::Restrictions light;
+  light.max_payload = 100;
+  topology::Restrictions short_only;
+  short_only.max_vehicle_length = 0.5;
+  topology::Restrictions narrow;
+  narrow.max_vehicle_width = 0.8;
+  const Case cases[] = {{"type on edge", only_people, {}},
+                        {"payload on edge", light, {}},
+                        {"length on goal", {}, short_only},
+                        {"width on goal", {}, narrow}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    GridBuilder g;
+    g.cell(0, 0).cell(1, 0).cell(2, 0, c.on_goal);
+    g.edge(0, 0, 1, 0).edge(1, 0, 2, 0, {.restrictions = c.on_edge});
+    World w(std::move(g).build());
+    PlanRequest request = request_to(w, "a", "0,0", {open_stop(w, "2,0")});
+    request.vehicle.payload = 250;
+    EXPECT_EQ(plan_error(w, request).reason, PlanFailure::restricted);
+  }
+}
+
+TEST(Planner, ReportsUnreachableForDisconnectedOrOneWayGraphs) {
+  GridBuilder g;
+  g.cell(0, 0).cell(1, 0).cell(2, 0).cell(5, 5);
+  g.edge(1, 0, 0, 0, {.bidirectional = false}).edge(1, 0, 2, 0);
+  World w(std::move(g).build());
+  EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "5,5")})).reason,
+            PlanFailure::unreachable);
+  EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")})).reason,
+            PlanFailure::unreachable);
+  // The one-way edge is fine the other way round.
+  EXPECT_EQ(plan_ok(w, request_to(w, "a", "2,0", {open_stop(w, "0,0")})).arrival, sec(2));
+}
+
+TEST(Planner, WaitsForALockToEnd) {
+  World w(GridBuilder().corridor(5).build());
+  ASSERT_TRUE(w.timelines.lock(w.at("2,0"), {sec(0), sec(5)}, "op", "spill").has_value());
+  EXPECT_EQ(plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")})).arrival, sec(8));
+}
+
+TEST(Planner, ReportsLockedWhenLocksBlockEveryRoute) {
+  World w(GridBuilder().corridor(5).build());
+  ASSERT_TRUE(w.timelines.lock(w.at("2,0"), {sec(0), kForever}, "op", "broken plate"));
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::locked);
+}
+
+TEST(Planner, ReportsNoWindowWhenTheGoalIsHeldForGoodByAnotherAgent) {
+  World w(GridBuilder().corridor(5).build());
+  w.occupy("b", "4,0", sec(3), kForever);
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_NE(e.message.find("agent b"), std::string::npos) << e.message;
+  // A visit with a dwell needs no open-ended window.
+  EXPECT_EQ(plan_ok(w, request_to(w, "a", "0,0", {dwell_stop(w, "2,0", 1)})).arrival, sec(2));
+}
+
+TEST(Planner, ReportsWhyTheStartIsNotFree) {
+  World w(GridBuilder().corridor(3).build());
+  w.occupy("b", "0,0", sec(0), sec(10));
+  EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")})).reason,
+            PlanFailure::no_window);
+  ASSERT_TRUE(w.timelines.lock(w.at("2,0"), {sec(0), sec(10)}, "op", "inspection"));
+  EXPECT_EQ(plan_error(w, request_to(w, "a", "2,0", {open_stop(w, "0,0")})).reason,
+            PlanFailure::locked);
+}
+
+TEST(Planner, GivesUpAtTheHorizon) {
+  World w(GridBuilder().corridor(5).build(), PlannerOptions{.horizon = sec(10)});
+  w.occupy("b", "2,0", sec(0), sec(100));
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_NE(e.message.find("horizon"), std::string::npos) << e.message;
+}
+
+TEST(Planner, PlansSeveralStopsInOneCallHoldingEachForItsDwell) {
+  World w(GridBuilder().corridor(5).build());
+  const PlanRequest request =
+      request_to(w, "a", "0,0", {dwell_stop(w, "4,0", 3), open_stop(w, "1,0")});
+  const Route route = plan_ok(w, request);
+  ASSERT_EQ(route.stop_arrivals.size(), 2u);
+  EXPECT_EQ(route.stop_arrivals[0], sec(4));
+  EXPECT_EQ(route.stop_arrivals[1], sec(4 + 3 + 3));
+  const RouteStep& pickup = route.steps[route.stop_steps[0]];
+  EXPECT_EQ(pickup.entity, w.at("4,0"));
+  EXPECT_EQ(pickup.window, (Interval{sec(4), sec(4 + 3 + 1)}));  // leaves at 7 s, +1 s
+  EXPECT_EQ(route.steps.back().window, (Interval{sec(10), kForever}));
+}
+
+TEST(Planner, ConsecutiveStopsAtOneVertexAreOneStep) {
+  World w(GridBuilder().corridor(3).build());
+  const Route route = plan_ok(
+      w, request_to(w, "a", "0,0", {dwell_stop(w, "2,0", 2), dwell_stop(w, "2,0", 5)}));
+  EXPECT_EQ(route.steps.size(), 5u);
+  EXPECT_EQ(route.stop_arrivals, (std::vector<TimeNs>{sec(2), sec(4)}));
+  EXPECT_EQ(route.steps.back().window, (Interval{sec(2), sec(9)}));
+}
+
+TEST(Planner, ALastStopWithADwellIsHeldOnlyThatLong) {
+  World w(GridBuilder().corridor(3).build());
+  w.occupy("b", "2,0", sec(10), kForever);
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {dwell_stop(w, "2,0", 2)}));
+  EXPECT_EQ(route.steps.back().window, (Interval{sec(2), sec(4)}));
+}
+
+TEST(Planner, PicksALaterWindowAtAStopWhenTheEarlyOneIsTooShortForTheDwell) {
+  World w(GridBuilder().corridor(3).build());
+  w.occupy("b", "2,0", sec(4), sec(6));
+  // Arriving at 2 s, a 3 s dwell would run into b at 4 s: a waits and arrives at 7 s
+  // (the edge into 2,0 is free from 6 s on).
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {dwell_stop(w, "2,0", 3)}));
+  EXPECT_EQ(route.arrival, sec(7));
+}
+
+TEST(Planner, AStartThatIsTheGoalIsHeldInPlace) {
+  World w(GridBuilder().corridor(3).build());
+  const Route route = plan_ok(w, request_to(w, "a", "1,0", {open_stop(w, "1,0")}, sec(7)));
+  EXPECT_EQ(route.steps, (std::vector<RouteStep>{{w.at("1,0"), {sec(7), kForever}}}));
+  EXPECT_EQ(route.travel_time, 0);
+}
+
+TEST(Planner, RejectsInvalidRequests) {
+  World w(GridBuilder().corridor(3).build());
+  const PlanRequest good = request_to(w, "a", "0,0", {dwell_stop(w, "1,0", 1), open_stop(w, "2,0")});
+  std::vector<std::pair<const char*, PlanRequest>> cases;
+  auto add = [&](const char* name, auto change) {
+    PlanRequest r = good;
+    change(r);
+    cases.emplace_back(name, r);
+  };
+  add("unknown start", [](PlanRequest& r) { r.start = 99; });
+  add("edge as start", [&](PlanRequest& r) { r.start = w.at("0,0-1,0"); });
+  add("unknown stop", [](PlanRequest& r) { r.stops[1].vertex = topology::kNoEntity; });
+  add("no stops", [](PlanRequest& r) { r.stops.clear(); });
+  add("negative dwell", [](PlanRequest& r) { r.stops[0].dwell = -1; });
+  add("zero last dwell", [](PlanRequest& r) { r.stops[1].dwell = 0; });
+  add("no agent", [](PlanRequest& r) { r.agent.clear(); });
+  add("zero speed", [](PlanRequest& r) { r.vehicle.max_speed = 0; });
+  add("nan length", [](PlanRequest& r) { r.vehicle.length = std::nan(""); });
+  add("negative payload", [](PlanRequest& r) { r.vehicle.payload = -1; });
+  add("negative start time", [](PlanRequest& r) { r.start_time = -5; });
+  for (const auto& [name, request] : cases) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(plan_error(w, request).reason, PlanFailure::invalid_request);
+  }
+  topology::TimelineSet wrong_size(std::vector<std::vector<topology::EntityIndex>>(2));
+  auto planned = w.planner.plan(wrong_size, good);
+  ASSERT_FALSE(planned.has_value());
+  EXPECT_EQ(planned.error().reason, PlanFailure::invalid_request);
+}
+
+TEST(Planner, ATestRouteReservesNothing) {
+  World w(GridBuilder().corridor(4).build());
+  w.occupy("b", "2,0", sec(0), sec(3));
+  const topology::TimelineSet before = w.timelines;
+  plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "3,0")}));
+  EXPECT_TRUE(w.timelines == before);
+}
+
+TEST(Planner, ARealRouteIsReservedWholeAndOthersPlanAroundIt) {
+  World w(GridBuilder().corridor(6).build());
+  const PlanRequest first = request_to(w, "a", "0,0", {open_stop(w, "3,0")});
+  auto reserved = w.planner.plan_and_reserve(w.timelines, first, 7);
+  ASSERT_TRUE(reserved.has_value()) << reserved.error().message;
+  for (std::uint32_t i = 0; i < reserved->steps.size(); ++i) {
+    const RouteStep& step = reserved->steps[i];
+    const auto& on = w.timelines.timeline(step.entity).reservations;
+    EXPECT_TRUE(std::any_of(on.begin(), on.end(), [&](const topology::Reservation& r) {
+      return r.agent == "a" && r.route == 7 && r.step == i && !r.shadow() && r.window == step.window;
+    })) << "step " << i;
+  }
+  // b stays at the far end: fine. c wants 3,0, held by a for good: refused.
+  const PlanRequest second = request_to(w, "b", "5,0", {open_stop(w, "5,0")});
+  ASSERT_TRUE(w.planner.plan_and_reserve(w.timelines, second, 1).has_value());
+  const topology::TimelineSet before = w.timelines;
+  auto refused = w.planner.plan_and_reserve(
+      w.timelines, request_to(w, "c", "1,0", {open_stop(w, "3,0")}, sec(20)), 1);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_TRUE(w.timelines == before) << "a refused real route must change nothing";
+}
+
+TEST(Planner, HeuristicTablesReusedAcrossCallsGiveTheSameRoutes) {
+  // One planner with a single cached table (multi-stop requests need several at once),
+  // another that is fresh for every request: same answers.
+  GridBuilder g;
+  for (int x = 0; x < 4; ++x) {
+    for (int y = 0; y < 3; ++y) g.cell(x, y);
+  }
+  for (int x = 0; x < 4; ++x) {
+    for (int y = 0; y < 3; ++y) {
+      if (x + 1 < 4) g.edge(x, y, x + 1, y, {.length = 1.0 + (x + y) % 3});
+      if (y + 1 < 3) g.edge(x, y, x, y + 1, {.length = 1.0 + (x * y) % 2});
+    }
+  }
+  World w(std::move(g).build(), PlannerOptions{.heuristic_tables = 1});
+  w.occupy("b", "1,1", sec(0), sec(4));
+  w.occupy("b", "2,2", sec(2), sec(9));
+  const char* cells[] = {"0,0", "3,2", "1,2", "2,0", "0,2", "3,0"};
+  for (int i = 0; i < 12; ++i) {
+    const PlanRequest request =
+        request_to(w, "a", cells[i % 6],
+                   {dwell_stop(w, cells[(i + 1) % 6], 1), dwell_stop(w, cells[(i + 3) % 6], 2),
+                    open_stop(w, cells[(i + 4) % 6])});
+    Planner fresh(w.graph);
+    auto expected = fresh.plan(w.timelines, request);
+    auto cached = w.planner.plan(w.timelines, request);
+    ASSERT_EQ(expected.has_value(), cached.has_value());
+    if (!expected) continue;
+    EXPECT_EQ(cached->arrival, expected->arrival) << "request " << i;
+    check_route(w.topology, w.timelines, request, *cached);
+  }
+}
+
+}  // namespace
+}  // namespace drover::carp::test
