@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "drover/topology/timeline.hpp"
@@ -29,9 +30,18 @@ struct TimelineSet::Impl {
                                   const std::function<bool(const Reservation&)>& doomed,
                                   TouchedSet& touched);
 
-  /// Removes a prepared set and its items, grants what that made grantable (kept for
-  /// take_grants) and increments the versions of what changed.
-  static void drop_prepared(TimelineSet& set, PrepareId id);
+  /// Every check of prepare (see its contract), for `op` ("prepare" or "reserve").
+  static Status admit(const TimelineSet& set, const std::vector<Reservation>& items,
+                      const std::vector<ExpectedVersion>& expected, const std::string& op);
+  /// Adds admitted items to their timelines, prepared or committed; records where.
+  static void insert(TimelineSet& set, const std::vector<Reservation>& items, bool prepared,
+                     TouchedSet& touched);
+
+  /// Removes a prepared set and its items and grants what that made grantable (kept for
+  /// take_grants). Records what changed in `touched`. \pre the set exists.
+  static void drop_prepared(TimelineSet& set, PrepareId id, TouchedSet& touched);
+  /// Keeps grants made by operations that do not report them, for take_grants.
+  static void keep_grants(TimelineSet& set, const std::vector<Grant>& grants);
 
   /// The agent's first committed real reservation on the timeline, or nullptr.
   static const Reservation* first_committed_real(const Timeline& timeline,

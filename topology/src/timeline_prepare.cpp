@@ -31,13 +31,13 @@ std::string owner_text(const Reservation& r) {
 /// The checks of prepare that need no timeline: well-formed, one route, consistent steps.
 Status check_well_formed(const std::vector<Reservation>& items, std::size_t entity_count,
                          const std::function<bool(EntityIndex, EntityIndex)>& conflicts) {
-  if (items.empty()) return fail(ErrorCode::invalid_argument, "prepare: no items");
+  if (items.empty()) return fail(ErrorCode::invalid_argument, "no items");
   const Reservation& first = items.front();
   std::map<std::uint32_t, std::size_t> first_of_step;
   std::set<std::pair<EntityIndex, std::uint32_t>> seen;
   for (std::size_t i = 0; i < items.size(); ++i) {
     const Reservation& item = items[i];
-    const std::string where = "prepare: " + item_text(i, item);
+    const std::string where = item_text(i, item);
     if (item.agent.empty()) {
       return fail(ErrorCode::invalid_argument, where + ": empty agent id");
     }
@@ -77,42 +77,42 @@ Status check_well_formed(const std::vector<Reservation>& items, std::size_t enti
 
 }  // namespace
 
-Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
-                                       const std::vector<ExpectedVersion>& expected,
-                                       TimeNs expires_at) {
+Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reservation>& items,
+                                const std::vector<ExpectedVersion>& expected,
+                                const std::string& op) {
   if (auto well_formed = check_well_formed(
-          items, entity_count(),
-          [this](EntityIndex origin, EntityIndex entity) {
-            return Impl::in_conflict_set(*this, origin, entity);
+          items, set.entity_count(),
+          [&set](EntityIndex origin, EntityIndex entity) {
+            return in_conflict_set(set, origin, entity);
           });
       !well_formed) {
-    return unexpected(std::move(well_formed).error());
+    return unexpected(Error{ErrorCode::invalid_argument, op + ": " + well_formed.error().message});
   }
   for (std::size_t i = 0; i < items.size(); ++i) {
-    if (!owns(items[i].entity)) {
-      return fail(ErrorCode::not_found, "prepare: " + item_text(i, items[i]) +
-                                            ": entity not owned by this set");
+    if (!set.owns(items[i].entity)) {
+      return fail(ErrorCode::not_found,
+                  op + ": " + item_text(i, items[i]) + ": entity not owned by this set");
     }
   }
   for (const ExpectedVersion& ev : expected) {
-    if (!owns(ev.entity)) {
-      return fail(ErrorCode::not_found, "prepare: expected version of entity " +
+    if (!set.owns(ev.entity)) {
+      return fail(ErrorCode::not_found, op + ": expected version of entity " +
                                             std::to_string(ev.entity) +
                                             ", which this set does not own");
     }
   }
   for (const ExpectedVersion& ev : expected) {
-    if (version(ev.entity) != ev.version) {
+    if (set.version(ev.entity) != ev.version) {
       return fail(ErrorCode::conflict,
-                  "prepare: entity " + std::to_string(ev.entity) + " is at version " +
-                      std::to_string(version(ev.entity)) + ", the plan expected version " +
+                  op + ": entity " + std::to_string(ev.entity) + " is at version " +
+                      std::to_string(set.version(ev.entity)) + ", the plan expected version " +
                       std::to_string(ev.version));
     }
   }
   for (std::size_t i = 0; i < items.size(); ++i) {
     const Reservation& item = items[i];
-    const Timeline& t = timelines_[item.entity];
-    const std::string where = "prepare: " + item_text(i, item);
+    const Timeline& t = set.timelines_[item.entity];
+    const std::string where = op + ": " + item_text(i, item);
     for (const Reservation& r : t.reservations) {
       if (r.agent == item.agent) {
         if (r.route == item.route && r.step == item.step) {
@@ -123,7 +123,7 @@ Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
       if (r.window.overlaps(item.window)) {
         return fail(ErrorCode::conflict, where + ": overlaps " + owner_text(r));
       }
-      if (item.window.start < r.window.start && Impl::is_held(*this, r)) {
+      if (item.window.start < r.window.start && is_held(set, r)) {
         return fail(ErrorCode::conflict,
                     where + ": would come before the allocated " + owner_text(r));
       }
@@ -136,18 +136,33 @@ Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
       }
     }
   }
+  return {};
+}
 
-  // Everything checked: apply.
-  PreparedSet held{items.front().agent, items.front().route, expires_at, {}};
-  TouchedSet touched;
-  for (const Reservation& item : items) {
-    Reservation r = item;
-    r.prepared = true;
-    timelines_[r.entity].reservations.push_back(std::move(r));
-    held.items.push_back(ItemKey{item.entity, item.step, item.origin});
-    touched.insert(item.entity);
+void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>& items,
+                               bool prepared, TouchedSet& touched) {
+  TouchedSet inserted;
+  for (Reservation r : items) {
+    r.prepared = prepared;
+    inserted.insert(r.entity);
+    set.timelines_[r.entity].reservations.push_back(std::move(r));
   }
-  for (EntityIndex entity : touched) Impl::sort_reservations(timelines_[entity]);
+  for (EntityIndex entity : inserted) sort_reservations(set.timelines_[entity]);
+  touched.insert(inserted.begin(), inserted.end());
+}
+
+Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
+                                       const std::vector<ExpectedVersion>& expected,
+                                       TimeNs expires_at) {
+  if (Status admitted = Impl::admit(*this, items, expected, "prepare"); !admitted) {
+    return unexpected(std::move(admitted).error());
+  }
+  PreparedSet held{items.front().agent, items.front().route, expires_at, {}};
+  for (const Reservation& item : items) {
+    held.items.push_back(ItemKey{item.entity, item.step, item.origin});
+  }
+  TouchedSet touched;
+  Impl::insert(*this, items, true, touched);
   Impl::bump_versions(*this, touched);
   const PrepareId id = next_prepare_id_++;
   prepared_.emplace(id, std::move(held));
@@ -171,26 +186,31 @@ Status TimelineSet::commit(PrepareId id) {
     }
     touched.insert(key.entity);
   }
-  Impl::bump_versions(*this, touched);
   prepared_.erase(found);
+  // The agent's own new reservation may come before everyone else's where it waits.
+  Impl::keep_grants(*this, Impl::grant_waiting(*this, TouchedSet(touched), touched));
+  Impl::bump_versions(*this, touched);
   return {};
 }
 
-void TimelineSet::Impl::drop_prepared(TimelineSet& set, PrepareId id) {
+void TimelineSet::Impl::keep_grants(TimelineSet& set, const std::vector<Grant>& grants) {
+  set.pending_grants_.insert(set.pending_grants_.end(), grants.begin(), grants.end());
+}
+
+void TimelineSet::Impl::drop_prepared(TimelineSet& set, PrepareId id, TouchedSet& touched) {
   const auto found = set.prepared_.find(id);
   const PreparedSet& held = found->second;
-  TouchedSet touched;
+  TouchedSet dropped;
   for (const ItemKey& key : held.items) {
     std::erase_if(set.timelines_[key.entity].reservations, [&](const Reservation& r) {
       return r.prepared && r.agent == held.agent && r.route == held.route &&
              r.step == key.step && r.origin == key.origin;
     });
-    touched.insert(key.entity);
+    dropped.insert(key.entity);
   }
   set.prepared_.erase(found);
-  std::vector<Grant> grants = grant_waiting(set, TouchedSet(touched), touched);
-  set.pending_grants_.insert(set.pending_grants_.end(), grants.begin(), grants.end());
-  bump_versions(set, touched);
+  touched.insert(dropped.begin(), dropped.end());
+  keep_grants(set, grant_waiting(set, dropped, touched));
 }
 
 Status TimelineSet::abort(PrepareId id) {
@@ -198,7 +218,9 @@ Status TimelineSet::abort(PrepareId id) {
     return fail(ErrorCode::not_found,
                 "abort: prepared set " + std::to_string(id) + " is unknown, committed or expired");
   }
-  Impl::drop_prepared(*this, id);
+  TouchedSet touched;
+  Impl::drop_prepared(*this, id, touched);
+  Impl::bump_versions(*this, touched);
   return {};
 }
 
@@ -207,7 +229,9 @@ std::vector<PrepareId> TimelineSet::expire(TimeNs now) {
   for (const auto& [id, held] : prepared_) {
     if (held.expires_at <= now) expired.push_back(id);
   }
-  for (PrepareId id : expired) Impl::drop_prepared(*this, id);
+  TouchedSet touched;
+  for (PrepareId id : expired) Impl::drop_prepared(*this, id, touched);
+  Impl::bump_versions(*this, touched);
   return expired;
 }
 
@@ -234,9 +258,13 @@ Status TimelineSet::reserve(const AgentId& agent, RouteId route,
   }
   std::vector<Reservation> items = expand(agent, route, steps);
   std::erase_if(items, [this](const Reservation& r) { return !owns(r.entity); });
-  Result<PrepareId> prepared = prepare(items, {}, kForever);
-  if (!prepared) return unexpected(std::move(prepared).error());
-  return commit(*prepared);
+  if (Status admitted = Impl::admit(*this, items, {}, "reserve"); !admitted) return admitted;
+  // One change, as if prepared and committed at once.
+  TouchedSet touched;
+  Impl::insert(*this, items, false, touched);
+  Impl::keep_grants(*this, Impl::grant_waiting(*this, TouchedSet(touched), touched));
+  Impl::bump_versions(*this, touched);
+  return {};
 }
 
 }  // namespace drover::topology

@@ -201,22 +201,25 @@ class TimelineSet {
   /// invalid_argument first, then not_found, then conflict.
   Result<PrepareId> prepare(const std::vector<Reservation>& items,
                             const std::vector<ExpectedVersion>& expected, TimeNs expires_at);
-  /// Makes a prepared set permanent. not_found if it was aborted or expired.
+  /// Makes a prepared set permanent. not_found if it was aborted or expired. Waiting
+  /// requests this makes grantable are granted (see take_grants).
   Status commit(PrepareId id);
-  /// Drops a prepared set. not_found if unknown.
+  /// Drops a prepared set. not_found if unknown. Waiting requests this makes grantable are
+  /// granted (see take_grants).
   Status abort(PrepareId id);
   /// Drops every prepared set whose expiry is <= now (presumed abort); returns their ids,
-  /// ascending.
+  /// ascending. Waiting requests this makes grantable are granted (see take_grants).
   std::vector<PrepareId> expire(TimeNs now);
 
-  /// The grants that abort and expire made (they free held items that waiting requests may
-  /// have queued behind, but report no grants themselves) since the last call, in the order
-  /// they were made.
+  /// The grants that commit, abort and expire made since the last call, in the order they
+  /// were made. (Aborting or expiring frees held items a waiting request may queue behind;
+  /// committing may put a waiting agent's new reservation before everyone else's. These
+  /// operations report no grants themselves.)
   std::vector<Grant> take_grants();
 
   /// prepare + commit in one step, of the items expand() writes on owned entities. Every
   /// step's entity must be owned (not_found); invalid_argument for no steps, an empty agent
-  /// id or a bad window.
+  /// id or a bad window. Grants as commit does (see take_grants).
   Status reserve(const AgentId& agent, RouteId route, const std::vector<RouteStep>& steps);
 
   /// Asks for the allocation of `entity`, where the agent must hold a committed real
@@ -290,7 +293,7 @@ class TimelineSet {
   std::vector<std::optional<HeldStep>> held_;     // per entity; set iff its holder is
   std::map<PrepareId, PreparedSet> prepared_;
   std::map<LockId, EntityIndex> lock_entities_;   // where each lock lives
-  std::vector<Grant> pending_grants_;             // made by abort/expire, see take_grants
+  std::vector<Grant> pending_grants_;             // see take_grants
   LockId next_lock_id_ = 1;
   PrepareId next_prepare_id_ = 1;
 };
