@@ -255,6 +255,18 @@ TEST(JsonFormat, TopLevelAndOptionProblemsAreReported) {
   EXPECT_NE(huge[0].what.find("malformed JSON"), std::string::npos) << huge[0].what;
 }
 
+TEST(JsonFormat, KeysGivenTwiceAreReportedWithTheirPath) {
+  const auto errors = errors_of(parse_topology_json(R"({"name": "d", "vertices": [
+      {"id": "a", "x": 0, "y": 0, "footprint": [[0, 0], [1, 0], [1, 1]]},
+      {"id": "b", "x": 1, "y": 0, "x": 2, "properties": {"k": "1", "k": "2"}}],
+      "edges": [], "name": "again"})"));
+  const std::string all = dump(errors);
+  EXPECT_TRUE(has_diagnostic(errors, "vertices[1].x", "key given twice")) << all;
+  EXPECT_TRUE(has_diagnostic(errors, "vertices[1].properties.k", "key given twice")) << all;
+  EXPECT_TRUE(has_diagnostic(errors, "name", "key given twice")) << all;
+  EXPECT_EQ(errors.size(), 3u) << all;
+}
+
 TEST(JsonFormat, FootprintPointsMustBePairsOfNumbers) {
   const auto errors = errors_of(parse_topology_json(R"({"name": "f", "vertices": [
       {"id": "a", "x": 0, "y": 0, "footprint": [[0, 0], [1], [1, "1"], 7]},

@@ -1,8 +1,10 @@
 #include "drover/topology/json_format.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -309,6 +311,65 @@ class SpecReader {
   Diagnostics diagnostics_;
 };
 
+/// Watches the parser for keys given twice in one object (JSON allows it and nlohmann keeps
+/// the last, which would let a pasted or misspelt duplicate pass silently). Tracks the JSON
+/// path of the value being parsed so that the duplicate can be named.
+class DuplicateKeyWatch {
+ public:
+  Diagnostics& duplicates() { return duplicates_; }
+
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, Json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        count_element();
+        frames_.push_back(Frame{event == Event::object_start, {}, 0, {}});
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        break;
+      case Event::key: {
+        Frame& object = frames_.back();
+        object.key = parsed.get<std::string>();
+        if (!object.keys.insert(object.key).second) {
+          duplicates_.push_back(Diagnostic{path(), "key given twice in the same object"});
+        }
+        break;
+      }
+      case Event::value:
+        count_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool object = false;
+    std::string key;              // objects: the key being parsed
+    std::size_t elements = 0;     // arrays: elements started so far
+    std::set<std::string> keys;   // objects: keys seen
+  };
+
+  void count_element() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().elements;
+  }
+
+  std::string path() const {
+    std::string where;
+    for (const Frame& frame : frames_) {
+      where = frame.object ? member(where, frame.key)
+                           : element(where, frame.elements == 0 ? 0 : frame.elements - 1);
+    }
+    return where;
+  }
+
+  std::vector<Frame> frames_;
+  Diagnostics duplicates_;
+};
+
 /// nlohmann reports "[json.exception.parse_error.101] parse error at line 3, column 5:
 /// syntax error ..."; split that into where ("line 3, column 5") and what.
 Diagnostic parse_failure(const nlohmann::json::parse_error& error) {
@@ -409,14 +470,16 @@ void write_list(std::string& out, std::string_view key, const Items& items, ToJs
 
 Result<Topology, Diagnostics> parse_topology_json(std::string_view text) {
   Json document;
+  DuplicateKeyWatch watch;
   try {
-    document = Json::parse(text.begin(), text.end());
+    document = Json::parse(text.begin(), text.end(), std::ref(watch));
   } catch (const nlohmann::json::parse_error& error) {
     return unexpected(Diagnostics{parse_failure(error)});
   } catch (const nlohmann::json::exception& error) {
     // Numbers beyond double range are reported as out_of_range, without a position.
     return unexpected(Diagnostics{Diagnostic{"", std::string("malformed JSON: ") + error.what()}});
   }
+  if (!watch.duplicates().empty()) return unexpected(std::move(watch.duplicates()));
   SpecReader reader;
   auto builder = reader.read_document(document);
   // Structural problems first: the builder's checks on half-read specs would only add noise.
