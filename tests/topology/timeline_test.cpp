@@ -371,10 +371,14 @@ TEST_F(TimelineTest, AllocateNeedsACommittedRealReservation) {
 TEST_F(TimelineTest, ReleaseNeedsTheHolderAndRemovesTheHeldStepOnly) {
   ASSERT_TRUE(set.reserve("amy", 1, {at(0, 0, 10), at(2, 9, 20), at(0, 19, 30)}));
   EXPECT_EQ(set.release("amy", 0).error().code, ErrorCode::not_permitted);
+  EXPECT_FALSE(set.allocated_step(0).has_value());
   ASSERT_TRUE(set.allocate("amy", 0)->granted);
+  EXPECT_EQ(set.allocated_step(0), (AllocatedStep{1, 0}));  // the first visit of 0
+  EXPECT_FALSE(set.allocated_step(1).has_value());
   EXPECT_EQ(set.release("bob", 0).error().code, ErrorCode::not_permitted);
   EXPECT_EQ(set.release("amy", 9).error().code, ErrorCode::not_found);
   ASSERT_TRUE(set.release("amy", 0).has_value());
+  EXPECT_FALSE(set.allocated_step(0).has_value());
   // The first visit of 0 and its shadow are gone; the second visit and step 1 stay.
   ASSERT_EQ(set.timeline(0).reservations.size(), 1u);
   EXPECT_EQ(set.timeline(0).reservations[0].step, 2u);

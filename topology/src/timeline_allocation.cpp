@@ -39,7 +39,7 @@ std::vector<Grant> TimelineSet::Impl::grant_waiting(TimelineSet& set, const Touc
     for (auto waiting = t.waiting.begin(); waiting != t.waiting.end(); ++waiting) {
       const Reservation* mine = first_committed_real(t, *waiting);
       if (others_before(t, *waiting, mine->window.start) > 0) continue;
-      set.held_[entity] = HeldStep{mine->route, mine->step};
+      set.held_[entity] = AllocatedStep{mine->route, mine->step};
       t.holder = *waiting;
       grants.push_back(Grant{*waiting, entity});
       t.waiting.erase(waiting);
@@ -66,7 +66,7 @@ Result<Allocation> TimelineSet::allocate(const AgentId& agent, EntityIndex entit
   }
   const std::size_t ahead = Impl::others_before(t, agent, mine->window.start);
   if (!t.holder && ahead == 0) {
-    held_[entity] = HeldStep{mine->route, mine->step};
+    held_[entity] = AllocatedStep{mine->route, mine->step};
     t.holder = agent;
     std::erase(t.waiting, agent);
     ++t.version;
@@ -81,6 +81,10 @@ Result<Allocation> TimelineSet::allocate(const AgentId& agent, EntityIndex entit
   return Allocation{false, ahead};
 }
 
+std::optional<AllocatedStep> TimelineSet::allocated_step(EntityIndex entity) const {
+  return owns(entity) ? held_[entity] : std::nullopt;
+}
+
 Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityIndex entity) {
   if (agent.empty()) return fail(ErrorCode::invalid_argument, "release: empty agent id");
   if (!owns(entity)) {
@@ -93,7 +97,7 @@ Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityInde
                 "release: agent " + agent + " does not hold entity " + std::to_string(entity) +
                     (t.holder ? " (held by " + *t.holder + ")" : " (nobody holds it)"));
   }
-  const HeldStep held = *held_[entity];
+  const AllocatedStep held = *held_[entity];
   TouchedSet touched{entity};
   const auto allocated = [&](const Reservation& r) {
     return r.agent == agent && r.route == held.route && r.step == held.step &&

@@ -96,6 +96,15 @@ struct Timeline {
   friend bool operator==(const Timeline&, const Timeline&) = default;
 };
 
+/// Which reservation an allocation holds: the holder's real reservation of this route step
+/// on the entity (its first committed one there when it was granted) and the step's shadows
+/// on the conflict set. Nobody may be placed before them; release removes them.
+struct AllocatedStep {
+  RouteId route = 0;
+  std::uint32_t step = 0;
+  friend bool operator==(const AllocatedStep&, const AllocatedStep&) = default;
+};
+
 /// Outcome of an allocation request.
 struct Allocation {
   bool granted = false;
@@ -230,6 +239,10 @@ class TimelineSet {
   /// on it; invalid_argument for an empty agent id.
   Result<Allocation> allocate(const AgentId& agent, EntityIndex entity);
 
+  /// The route step the holder of `entity` holds; nullopt when nobody holds it (or the
+  /// entity is not owned). Timeline::holder names the agent.
+  std::optional<AllocatedStep> allocated_step(EntityIndex entity) const;
+
   /// Gives up the allocation of `entity`: removes the agent's allocated reservation there
   /// and its shadows. not_permitted if the agent does not hold it.
   /// \return the waiting requests that this made grantable (now granted), by entity.
@@ -279,18 +292,10 @@ class TimelineSet {
     std::vector<ItemKey> items;
     friend bool operator==(const PreparedSet&, const PreparedSet&) = default;
   };
-  /// Which reservation an allocation holds: the holder's real reservation of this route
-  /// step on the entity, and the step's shadows on the conflict set.
-  struct HeldStep {
-    RouteId route = 0;
-    std::uint32_t step = 0;
-    friend bool operator==(const HeldStep&, const HeldStep&) = default;
-  };
-
   std::vector<std::vector<EntityIndex>> conflict_sets_;
   std::vector<bool> owned_;                       // one flag per entity
   std::vector<Timeline> timelines_;
-  std::vector<std::optional<HeldStep>> held_;     // per entity; set iff its holder is
+  std::vector<std::optional<AllocatedStep>> held_;  // per entity; set iff its holder is
   std::map<PrepareId, PreparedSet> prepared_;
   std::map<LockId, EntityIndex> lock_entities_;   // where each lock lives
   std::vector<Grant> pending_grants_;             // see take_grants
