@@ -1,0 +1,43 @@
+#include "drover/dds/qos.hpp"
+
+namespace drover::dds {
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+
+eprosima::fastrtps::Duration_t to_duration(std::chrono::milliseconds ms) {
+  return eprosima::fastrtps::Duration_t(static_cast<long double>(ms.count()) / 1000.0L);
+}
+
+template <class EndpointQos>
+void apply(const TopicQos& qos, EndpointQos& out) {
+  out.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  out.durability().kind =
+      qos.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
+  if (qos.history_depth > 0) {
+    out.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    out.history().depth = qos.history_depth;
+  } else {
+    out.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  }
+  if (qos.deadline.count() > 0) out.deadline().period = to_duration(qos.deadline);
+}
+
+}  // namespace
+
+fdds::DataWriterQos writer_qos(const TopicQos& qos) {
+  fdds::DataWriterQos out = fdds::DATAWRITER_QOS_DEFAULT;
+  apply(qos, out);
+  // A blocked reliable writer (history full of unacknowledged samples) waits this long
+  // before write() fails, instead of the default 100 ms.
+  out.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(1, 0);
+  return out;
+}
+
+fdds::DataReaderQos reader_qos(const TopicQos& qos) {
+  fdds::DataReaderQos out = fdds::DATAREADER_QOS_DEFAULT;
+  apply(qos, out);
+  return out;
+}
+
+}  // namespace drover::dds

@@ -1,0 +1,80 @@
+#include "tests/agents/child_process.hpp"
+
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <utility>
+
+extern char** environ;
+
+namespace drover::test {
+
+std::optional<ChildProcess> ChildProcess::spawn(const std::string& path,
+                                                const std::vector<std::string>& args) {
+  std::vector<std::string> argv_storage;
+  argv_storage.push_back(path);
+  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& arg : argv_storage) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+
+  pid_t pid = -1;
+  if (const int error = posix_spawn(&pid, path.c_str(), nullptr, nullptr, argv.data(), environ);
+      error != 0) {
+    std::cerr << "cannot start " << path << ": " << std::strerror(error) << "\n";
+    return std::nullopt;
+  }
+  const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
+  if (pidfd < 0) {
+    std::cerr << "pidfd_open failed: " << std::strerror(errno) << "\n";
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+    return std::nullopt;
+  }
+  return ChildProcess(pid, pidfd);
+}
+
+ChildProcess::ChildProcess(ChildProcess&& other) noexcept
+    : pid_(std::exchange(other.pid_, -1)), pidfd_(std::exchange(other.pidfd_, -1)) {}
+
+ChildProcess::~ChildProcess() {
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+  if (pidfd_ >= 0) ::close(pidfd_);
+}
+
+void ChildProcess::signal(int signal_number) const {
+  if (pid_ > 0) ::kill(pid_, signal_number);
+}
+
+std::optional<ExitStatus> ChildProcess::wait_exit(std::chrono::milliseconds timeout) {
+  if (pid_ <= 0) return std::nullopt;
+  pollfd fd{pidfd_, POLLIN, 0};
+  int ready = 0;
+  do {
+    ready = ::poll(&fd, 1, static_cast<int>(timeout.count()));
+  } while (ready < 0 && errno == EINTR);
+  if (ready <= 0) return std::nullopt;
+  int status = 0;
+  if (::waitpid(pid_, &status, 0) != pid_) return std::nullopt;
+  pid_ = -1;
+  if (WIFEXITED(status)) return ExitStatus{true, WEXITSTATUS(status)};
+  return ExitStatus{false, WIFSIGNALED(status) ? WTERMSIG(status) : 0};
+}
+
+std::string binary_path(const std::string& name) {
+  const char* dir = std::getenv("DROVER_BINARY_DIR");
+  return std::string(dir != nullptr ? dir : ".") + "/bin/" + name;
+}
+
+}  // namespace drover::test
