@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "drover/topology/timeline.hpp"
@@ -232,6 +233,17 @@ TEST_F(TimelineDelay, TheCheckerCatchesBrokenDelays) {
   fake = *report;  // a lock hit that did not happen
   fake.hit_locks.push_back(after.timelines[4].reservations[0]);
   EXPECT_FALSE(reference::check_delay(before, after, "amy", 1, 0, 5, fake).empty());
+  bad = after;  // bob pushed one further than needed (and reported so)
+  for (EntityIndex e : {2u, 4u}) {
+    for (Reservation& r : bad.timelines[e].reservations) {
+      if (r.agent == "bob") r.window = {r.window.start + 1, r.window.end + 1};
+    }
+  }
+  fake = *report;
+  fake.shifts[1].by += 1;
+  const auto violations = reference::check_delay(before, bad, "amy", 1, 0, 5, fake);
+  ASSERT_EQ(violations.size(), 1u);
+  EXPECT_NE(violations[0].find("further than needed"), std::string::npos);
   bad = after;  // a holder appeared
   bad.timelines[2].holder = "bob";
   EXPECT_FALSE(reference::check_delay(before, bad, "amy", 1, 0, 5, *report).empty());

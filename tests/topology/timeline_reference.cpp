@@ -740,6 +740,31 @@ std::vector<std::string> check_delay(const Snapshot& before, const Snapshot& aft
       out.push_back("wrong shift reported for " + shift.agent + "/" + std::to_string(shift.route));
     }
   }
+  // A pushed route moves no further than needed: where its largest shift begins, one of its
+  // reservations starts exactly when a reservation of another agent before it now ends.
+  for (std::size_t i = 1; i < report.shifts.size(); ++i) {
+    const RouteKey key{report.shifts[i].agent, report.shifts[i].route};
+    std::optional<std::uint32_t> first_step;
+    for (const auto& [k, old] : old_by_key) {
+      if (RouteKey{old.agent, old.route} == key &&
+          new_by_key[k].window.start - old.window.start == largest_move[key] &&
+          (!first_step || old.step < *first_step)) {
+        first_step = old.step;
+      }
+    }
+    bool tight = false;
+    for (const auto& [k, old] : old_by_key) {
+      if (RouteKey{old.agent, old.route} != key || !first_step || old.step != *first_step) continue;
+      const Reservation& now = new_by_key[k];
+      for (const Reservation& x : before.timelines[old.entity].reservations) {
+        if (x.agent != old.agent && x.window.start < old.window.start &&
+            new_by_key[key_of(x)].window.end == now.window.start) {
+          tight = true;
+        }
+      }
+    }
+    if (!tight) out.push_back("pushed further than needed: " + key.first + "/" + std::to_string(key.second));
+  }
   for (const RouteKey& key : moved_routes) {
     if (!reported.contains(key)) {
       out.push_back("moved but not reported: " + key.first + "/" + std::to_string(key.second));
