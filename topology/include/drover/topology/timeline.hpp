@@ -151,6 +151,37 @@ struct ExpectedVersion {
   std::uint64_t version = 0;
 };
 
+/// The allocation an entity's holder holds, as a snapshot records it.
+struct Holding {
+  AgentId agent;
+  AllocatedStep step;
+  friend bool operator==(const Holding&, const Holding&) = default;
+};
+
+/// What of one entity survives a restart of its topology agent: the committed
+/// reservations (real and shadow), the locks and the allocation. Prepared holds and waiting
+/// allocation requests are left out: a restart aborts them (presumed abort; their
+/// requesters time out and ask again).
+struct EntitySnapshot {
+  EntityIndex entity = kNoEntity;
+  /// The timeline's version; one more than the live one when the snapshot left out
+  /// prepared holds or waiting requests (dropping them is a change of the timeline).
+  std::uint64_t version = 0;
+  std::vector<Reservation> reservations;  ///< committed only, in timeline order
+  std::vector<Lock> locks;                ///< in timeline order
+  std::optional<Holding> holding;         ///< the holder and the step it holds
+  friend bool operator==(const EntitySnapshot&, const EntitySnapshot&) = default;
+};
+
+/// The committed state of some owned entities of a TimelineSet plus its id counters: what
+/// a topology agent journals after each operation and restores from on restart.
+struct TimelineSnapshot {
+  std::vector<EntitySnapshot> entities;  ///< ascending by entity
+  LockId next_lock_id = 1;               ///< the id the next lock gets
+  PrepareId next_prepare_id = 1;         ///< the id the next prepare gets (never reused)
+  friend bool operator==(const TimelineSnapshot&, const TimelineSnapshot&) = default;
+};
+
 /// The timelines of a set of entities (all of a topology, or one partition's).
 class TimelineSet {
  public:
@@ -273,6 +304,34 @@ class TimelineSet {
                           std::string reason);
   /// Removes a lock. not_found if unknown.
   Status unlock(LockId id);
+
+  // ---- persistence (timeline_snapshot.cpp) ----
+
+  /// The committed state of every owned entity that is not empty at version 0 (see
+  /// EntitySnapshot), and the id counters. Restoring it rebuilds this set as it would be
+  /// after a restart: the same except that nothing is prepared and nobody waits.
+  TimelineSnapshot snapshot() const;
+  /// The same for `entities` only (those an operation changed, for a journal); entities
+  /// not owned are skipped, duplicates taken once.
+  TimelineSnapshot snapshot(const std::vector<EntityIndex>& entities) const;
+
+  /// Rebuilds a set from a snapshot of it: the owned entities the snapshot names get its
+  /// state, the others are empty at version 0; nothing is prepared, nobody waits.
+  /// restore(c, o, set.snapshot()).snapshot() == set.snapshot().
+  /// \param conflict_sets, owned  as for the constructor (the same topology and partition
+  ///                              the snapshot was taken of)
+  /// \return invalid_argument naming the entity and the item when the snapshot is
+  ///         inconsistent: an entity out of range, not owned or given twice; a reservation
+  ///         that is prepared, has an empty agent or window, sits on another timeline, is a
+  ///         shadow of an entity it does not conflict with, repeats its step, or overlaps
+  ///         another agent's (I1); a real reservation without its shadow on an owned member
+  ///         of its conflict set, or a shadow without its real reservation on an owned
+  ///         origin (same window); a holder without its committed real reservation, with
+  ///         another agent's reservation before it (I2), or next to another agent holding
+  ///         a conflicting entity; a lock that is malformed, on another timeline, repeats
+  ///         an id or has an id not below next_lock_id; a counter of 0.
+  static Result<TimelineSet> restore(std::vector<std::vector<EntityIndex>> conflict_sets,
+                                     std::vector<bool> owned, const TimelineSnapshot& snapshot);
 
  private:
   struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
