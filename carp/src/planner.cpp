@@ -59,6 +59,38 @@ std::string blocker_text(const topology::Topology& topology, const TimelineSet& 
   return "another agent's allocation there (nobody may come before a holder)";
 }
 
+/// What holds `entity` (or a member of its conflict set) open-ended against `agent`: the
+/// reason it is never free for good.
+std::string forever_blocker_text(const topology::Topology& topology, const TimelineSet& timelines,
+                                 EntityIndex entity, std::string_view agent, TimeNs from) {
+  std::vector<EntityIndex> places{entity};
+  places.insert(places.end(), topology.conflicts(entity).begin(),
+                topology.conflicts(entity).end());
+  for (const EntityIndex place : places) {
+    if (!timelines.owns(place)) continue;
+    const topology::Timeline& timeline = timelines.timeline(place);
+    for (const topology::Lock& lock : timeline.locks) {
+      if (lock.window.end == kForever) {
+        return blocker_text(topology, timelines, place, agent, lock.window.start);
+      }
+    }
+    for (const topology::Reservation& r : timeline.reservations) {
+      if (r.agent != agent && r.window.end == kForever) {
+        return blocker_text(topology, timelines, place, agent, r.window.start);
+      }
+    }
+  }
+  return blocker_text(topology, timelines, entity, agent, from);
+}
+
+/// True when any entity has a lock (else a search without locks would find nothing new).
+bool any_lock(const TimelineSet& timelines) {
+  for (EntityIndex e = 0; e < timelines.entity_count(); ++e) {
+    if (timelines.owns(e) && !timelines.timeline(e).locks.empty()) return true;
+  }
+  return false;
+}
+
 /// True when some path leads from `from` to `to`, whatever the vehicle.
 bool connected(const RoutingGraph& graph, EntityIndex from, EntityIndex to) {
   std::vector<std::uint8_t> seen(graph.vertex_count(), 0);
@@ -214,11 +246,11 @@ struct Planner::Impl {
                      fmt::format("the last stop {} is never free for good (open-ended) from "
                                  "{} on: {}",
                                  vertex_name(goal), time_text(from),
-                                 blocker_text(topology(), timelines, goal, agent, from)));
+                                 forever_blocker_text(topology(), timelines, goal, agent, from)));
       }
     }
     input.count_locks = false;
-    if (search.run(input).found) {
+    if (any_lock(timelines) && search.run(input).found) {
       return error(PlanFailure::locked,
                    fmt::format("locks block every route to {}; without them it would arrive "
                                "at {}",

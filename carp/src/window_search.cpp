@@ -28,6 +28,7 @@ void WindowSearch::begin(const SearchInput& input) {
   windows_.clear();
   states_.clear();
   open_.clear();
+  sequence_ = 0;
   goal_state_ = kNone;
 }
 
@@ -77,7 +78,7 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
   s.entry = entry;
   s.ready = ready;
   s.parent = parent;
-  open_.push(OpenEntry{ready + estimate, ready, state});
+  open_.push(OpenEntry{ready + estimate, ready, sequence_++, state, kNone});
 }
 
 void WindowSearch::enter(const SearchInput& input, std::uint32_t from, std::uint32_t node,
@@ -131,6 +132,12 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
+    if (top.arc != kNone) {  // a deferred move onto an arc: now look at its windows
+      const ArcIndex a = top.arc;
+      enter(input, top.state, vertices + a, graph.arc(a).edge, traversal.clearance(a),
+            traversal.travel(a), top.f - top.ready, outcome);
+      continue;
+    }
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
     popped.closed = true;
@@ -143,38 +150,48 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
             estimate(input, current.layer, to), outcome);
       continue;
     }
-
-    const EntityIndex vertex = current.node;
-    const Leg& leg = input.legs[current.layer];
-    if (vertex == leg.stop) {
-      if (current.layer + 1u == input.legs.size()) {
-        if (completes(input, current)) {
-          goal_state_ = top.state;
-          outcome.found = true;
-          return outcome;
-        }
-      } else {
-        // Make the stop: stay for the dwell, then head for the next one from here.
-        const TimeNs ready = current.ready + leg.dwell;
-        const DurationNs next_estimate = estimate(input, current.layer + 1u, vertex);
-        if (ready > input.deadline) {
-          outcome.horizon_cut = true;
-        } else if (ready < windows_[current.window].end && next_estimate != kUnreachable) {
-          const std::uint32_t block = states_of(input, current.layer + 1u, vertex);
-          improve(block + (current.window - entity_first_[vertex]), current.entry, ready,
-                  top.state, next_estimate);
-        }
-      }
+    if (current.node == input.legs[current.layer].stop &&
+        current.layer + 1u == input.legs.size() && completes(input, current)) {
+      goal_state_ = top.state;
+      outcome.found = true;
+      return outcome;
     }
-    for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-      if (!traversal.usable_arc(a)) continue;
-      const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
-      if (arc_estimate == kUnreachable) continue;
-      enter(input, top.state, vertices + a, graph.arc(a).edge, traversal.clearance(a),
-            traversal.travel(a), arc_estimate, outcome);
-    }
+    expand_vertex(input, top.state, current, outcome);
   }
   return outcome;
+}
+
+void WindowSearch::expand_vertex(const SearchInput& input, std::uint32_t index,
+                                 const State& current, SearchOutcome& outcome) {
+  const RoutingGraph& graph = *input.graph;
+  const Traversal& traversal = *input.traversal;
+  const EntityIndex vertex = current.node;
+  const Leg& leg = input.legs[current.layer];
+  if (vertex == leg.stop && current.layer + 1u < input.legs.size()) {
+    // Make the stop: stay for the dwell, then head for the next one from here.
+    const TimeNs ready = current.ready + leg.dwell;
+    const DurationNs next_estimate = estimate(input, current.layer + 1u, vertex);
+    if (ready > input.deadline) {
+      outcome.horizon_cut = true;
+    } else if (ready < windows_[current.window].end && next_estimate != kUnreachable) {
+      const std::uint32_t block = states_of(input, current.layer + 1u, vertex);
+      improve(block + (current.window - entity_first_[vertex]), current.entry, ready, index,
+              next_estimate);
+    }
+  }
+  // Moves onto the arcs are deferred: keyed by the earliest arrival they could give.
+  for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
+    if (!traversal.usable_arc(a)) continue;
+    if (current.ready + traversal.clearance(a) > windows_[current.window].end) continue;
+    const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
+    if (arc_estimate == kUnreachable) continue;
+    const TimeNs earliest = current.ready + traversal.travel(a);
+    if (earliest > input.deadline) {
+      outcome.horizon_cut = true;
+      continue;
+    }
+    open_.push(OpenEntry{earliest + arc_estimate, earliest, sequence_++, index, a});
+  }
 }
 
 Route WindowSearch::route(const SearchInput& input) const {

@@ -64,12 +64,21 @@ class WindowSearch {
     std::uint16_t layer;
     bool closed;
   };
+  /// An open state, or (arc != kNone) a deferred move from a closed vertex state onto an
+  /// arc, keyed by the earliest the move could get there: the arc's windows are looked up
+  /// only if the search ever gets that far, which spares most free-window queries.
   struct OpenEntry {
     TimeNs f;
     TimeNs ready;
+    std::uint32_t sequence;  // push order
     std::uint32_t state;
+    std::uint32_t arc;
+    /// Ties go to the later state, then to the newest entry: on grids many paths are
+    /// equally fast, and going deep along one spares exploring all of them.
     bool operator>(const OpenEntry& o) const {
-      return f != o.f ? f > o.f : ready < o.ready;  // ties: the deeper state first
+      if (f != o.f) return f > o.f;
+      if (ready != o.ready) return ready < o.ready;
+      return sequence < o.sequence;
     }
   };
   static constexpr std::uint32_t kNone = 0xffffffffu;
@@ -89,6 +98,8 @@ class WindowSearch {
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
                DurationNs estimate);
   bool completes(const SearchInput& input, const State& state) const;
+  void expand_vertex(const SearchInput& input, std::uint32_t index, const State& current,
+                     SearchOutcome& outcome);
 
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
@@ -96,6 +107,7 @@ class WindowSearch {
   std::vector<topology::Interval> windows_;
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
+  std::uint32_t sequence_ = 0;
   std::uint32_t goal_state_ = kNone;
 };
 

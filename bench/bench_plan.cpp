@@ -1,0 +1,280 @@
+#include "bench/bench_plan.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "bench/scenario.hpp"
+#include "drover/carp/free_path.hpp"
+#include "drover/carp/planner.hpp"
+#include "drover/common/logging.hpp"
+#include "drover/topology/movingai.hpp"
+
+namespace drover::bench {
+
+namespace {
+
+using carp::PlanError;
+using carp::Route;
+using topology::EntityIndex;
+
+struct PlanBenchArguments {
+  std::string map;
+  std::string scenario;
+  std::size_t agents = 0;
+  std::string paths;
+  int repeat = 1;
+};
+
+/// One agent of the benchmark: a scenario task on the imported map.
+struct Agent {
+  std::string id;
+  EntityIndex start = topology::kNoEntity;
+  EntityIndex goal = topology::kNoEntity;
+};
+
+/// What became of one agent's route.
+struct Outcome {
+  std::optional<Route> route;
+  std::optional<PlanError> error;
+};
+
+struct CarpRun {
+  std::vector<Outcome> outcomes;
+  double plan_seconds = 0;     ///< in the planner (search and route)
+  double reserve_seconds = 0;  ///< in TimelineSet::reserve (writing the routes)
+};
+
+constexpr topology::RouteId kRoute = 1;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+carp::VehicleProfile bench_vehicle(double cell_size) {
+  carp::VehicleProfile vehicle;
+  vehicle.id = "bench";
+  vehicle.type = "agv";
+  vehicle.max_speed = 1.0;      // unit speed: a cell per second
+  vehicle.length = cell_size;   // one cell in size
+  vehicle.width = cell_size;
+  return vehicle;
+}
+
+/// Plain reservation-free A* for every agent. \return the seconds it took.
+double run_astar(const std::shared_ptr<const carp::RoutingGraph>& graph,
+                 const std::vector<Agent>& agents, const carp::VehicleProfile& vehicle,
+                 std::size_t& found) {
+  carp::FreePathSearch search(graph);
+  found = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (const Agent& agent : agents) {
+    if (search.find(vehicle, agent.start, agent.goal)) ++found;
+  }
+  return seconds_since(start);
+}
+
+/// Prioritized planning with CARP, in scenario order: each agent gets a real route from
+/// time 0 (its start held from 0 until it leaves) to its goal, held open-ended, around the
+/// routes of the agents before it. The timelines only gain reservations, so an agent that
+/// fails would fail again later: there is no retry (see docs/benchmarks.md).
+CarpRun run_carp(const std::shared_ptr<const carp::RoutingGraph>& graph,
+                 const std::vector<Agent>& agents, const carp::VehicleProfile& vehicle) {
+  topology::TimelineSet timelines(graph->topology().conflict_sets());
+  carp::Planner planner(graph);
+  CarpRun run;
+  run.outcomes.resize(agents.size());
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    carp::PlanRequest request;
+    request.agent = agents[i].id;
+    request.vehicle = vehicle;
+    request.start = agents[i].start;
+    request.start_time = 0;
+    request.stops = {carp::Stop{agents[i].goal, std::nullopt}};
+    auto start = std::chrono::steady_clock::now();
+    auto planned = planner.plan(timelines, request);
+    run.plan_seconds += seconds_since(start);
+    if (!planned) {
+      run.outcomes[i].error = std::move(planned).error();
+      continue;
+    }
+    start = std::chrono::steady_clock::now();
+    auto reserved = timelines.reserve(request.agent, kRoute, planned->steps);
+    run.reserve_seconds += seconds_since(start);
+    if (!reserved) {
+      throw std::runtime_error("the timelines refused the planned route of " + request.agent +
+                               ": " + reserved.error().message);
+    }
+    run.outcomes[i].route = std::move(planned).value();
+  }
+  return run;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
+}
+
+nlohmann::json steps_json(const topology::Topology& topology, const Route& route) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& step : route.steps) {
+    steps.push_back({{"entity", topology.id(step.entity)},
+                     {"enter", ns_to_seconds(step.window.start)},
+                     {"leave", step.window.end == kForever ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(ns_to_seconds(step.window.end))}});
+  }
+  return steps;
+}
+
+int run_plan_bench(const PlanBenchArguments& arguments) {
+  const auto logger = make_agent_logger("bench-plan");
+  topology::MovingAiOptions map_options;  // 1 m cells, 1 m/s edges
+  const auto loaded = topology::load_movingai_map(arguments.map, map_options);
+  if (!loaded) {
+    for (const auto& problem : loaded.error()) {
+      std::cerr << "error: " << arguments.map << (problem.where.empty() ? "" : ":" + problem.where)
+                << ": " << problem.what << "\n";
+    }
+    return cli::kExitBadInput;
+  }
+  const auto tasks = load_scenario(arguments.scenario);
+  if (!tasks) {
+    std::cerr << "error: " << tasks.error().message << "\n";
+    return cli::kExitBadInput;
+  }
+  if (arguments.agents > tasks->size()) {
+    std::cerr << "error: " << arguments.scenario << ": --agents " << arguments.agents
+              << " but the scenario has only " << tasks->size() << " tasks\n";
+    return cli::kExitBadInput;
+  }
+  const topology::Topology& map = *loaded;
+  const std::string map_name = std::filesystem::path(arguments.map).filename().string();
+
+  std::vector<Agent> agents;
+  for (std::size_t i = 0; i < arguments.agents; ++i) {
+    const ScenarioTask& task = (*tasks)[i];
+    if (task.map != map_name) {
+      logger->warn("{}:{}: the task is for map {}, running it on {}", arguments.scenario,
+                   task.line, task.map, map_name);
+    }
+    const auto start = map.find(fmt::format("{},{}", task.start_x, task.start_y));
+    const auto goal = map.find(fmt::format("{},{}", task.goal_x, task.goal_y));
+    if (!start || !goal) {
+      std::cerr << "error: " << arguments.scenario << ":" << task.line << ": "
+                << (!start ? "start" : "goal") << " cell is not a passable cell of "
+                << arguments.map << "\n";
+      return cli::kExitBadInput;
+    }
+    agents.push_back(Agent{fmt::format("agent-{}", i), *start, *goal});
+  }
+
+  const auto graph = std::make_shared<const carp::RoutingGraph>(map);
+  const carp::VehicleProfile vehicle = bench_vehicle(map_options.cell_size);
+
+  std::vector<double> astar_times, plan_times, reserve_times;
+  std::size_t astar_found = 0;
+  CarpRun run;
+  for (int r = 0; r < arguments.repeat; ++r) {
+    astar_times.push_back(run_astar(graph, agents, vehicle, astar_found));
+    run = run_carp(graph, agents, vehicle);
+    plan_times.push_back(run.plan_seconds);
+    reserve_times.push_back(run.reserve_seconds);
+  }
+
+  std::size_t planned = 0;
+  double sum_of_costs = 0, makespan = 0;
+  std::map<std::string, std::size_t> failures;
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    const Outcome& outcome = run.outcomes[i];
+    if (outcome.route) {
+      ++planned;
+      const double arrival = ns_to_seconds(outcome.route->arrival);
+      sum_of_costs += arrival;
+      makespan = std::max(makespan, arrival);
+    } else {
+      ++failures[carp::to_string(outcome.error->reason)];
+      logger->info("{} ({} -> {}) not planned: {}: {}", agents[i].id, map.id(agents[i].start),
+                   map.id(agents[i].goal), carp::to_string(outcome.error->reason),
+                   outcome.error->message);
+    }
+  }
+  const double plan_seconds = median(plan_times);
+  const double astar_seconds = median(astar_times);
+  nlohmann::json line = {
+      {"map", map_name},
+      {"agents", agents.size()},
+      {"planned", planned},
+      {"failed", agents.size() - planned},
+      {"sum_of_costs", sum_of_costs},
+      {"makespan", makespan},
+      {"plan_seconds", plan_seconds},
+      {"astar_seconds", astar_seconds},
+      {"ratio_to_astar", astar_seconds > 0 ? plan_seconds / astar_seconds : 0.0},
+      {"reserve_seconds", median(reserve_times)},
+      {"failures", failures},
+      {"astar_found", astar_found},
+  };
+  std::cout << line.dump() << "\n";
+
+  if (!arguments.paths.empty()) {
+    std::ofstream out(arguments.paths);
+    for (std::size_t i = 0; i < agents.size() && out; ++i) {
+      nlohmann::json path = {{"agent", i}};
+      const Outcome& outcome = run.outcomes[i];
+      if (outcome.route) {
+        path["steps"] = steps_json(map, *outcome.route);
+      } else {
+        path["steps"] = nlohmann::json::array();
+        path["error"] = fmt::format("{}: {}", carp::to_string(outcome.error->reason),
+                                    outcome.error->message);
+      }
+      out << path.dump() << "\n";
+    }
+    if (!out) {
+      std::cerr << "error: " << arguments.paths << ": cannot write the paths file\n";
+      return cli::kExitFailure;
+    }
+  }
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+void add_bench_plan_command(CLI::App& bench, cli::CommandContext& context) {
+  auto arguments = std::make_shared<PlanBenchArguments>();
+  auto* plan = bench.add_subcommand(
+      "plan",
+      "Plan the first N tasks of a MovingAI scenario one after another as real CARP routes "
+      "from time 0 (goals held open-ended) and time it against a reservation-free A* on the "
+      "same start/goal pairs; prints one JSON line");
+  plan->add_option("--map", arguments->map, "MovingAI .map file")->required();
+  plan->add_option("--scen", arguments->scenario, "MovingAI .scen file")->required();
+  plan->add_option("--agents", arguments->agents, "How many scenario tasks to plan (N >= 1)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  plan->add_option("--paths", arguments->paths,
+                   "Also write one JSON line per agent with its steps to this file");
+  plan->add_option("--repeat", arguments->repeat,
+                   "Run the whole measurement this many times and report median times")
+      ->check(CLI::Range(1, 100));
+  plan->callback([arguments, &context] {
+    try {
+      context.exit_code = run_plan_bench(*arguments);
+    } catch (const std::exception& e) {
+      std::cerr << "error: bench plan: " << e.what() << "\n";
+      context.exit_code = cli::kExitFailure;
+    }
+  });
+}
+
+}  // namespace drover::bench
