@@ -22,4 +22,7 @@ struct CommandContext {
 /// `drover topology ...` (validate and friends).
 void add_topology_commands(CLI::App& app, CommandContext& context);
 
+/// `drover ran-sim ...`: a simulated vehicle as a RAN process (agents/ran_runner/cli/).
+void add_ran_commands(CLI::App& app, CommandContext& context);
+
 }  // namespace drover::cli

@@ -19,6 +19,8 @@ class SimDriver final : public VehicleDriver {
   void on_resume(TimeNs now) override;
   /// Advances the simulation and reports (the runner calls this at the status rate).
   void on_tick(TimeNs now) override;
+  /// False while a simulated connection loss lasts (SimVehicle::lose_connection).
+  bool connected() const override { return vehicle_.connected(); }
 
   /// The simulation, e.g. to inject faults; call it from the runner's thread only, and
   /// call on_tick afterwards so the change is reported.

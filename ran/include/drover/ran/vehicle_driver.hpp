@@ -32,9 +32,10 @@ class StatusSink {
   std::uint64_t last_sequence_ = 0;
 };
 
-/// A vehicle driver. The runner calls every member from one thread, one call at a time, so
-/// an implementation needs no locking for its own state unless it starts threads itself.
-/// Every call carries `now`, the shared-clock time of the call.
+/// A vehicle driver. The runner calls its members one at a time, never concurrently (each
+/// call completes before the next starts, possibly on another thread), so an implementation
+/// needs no locking for its own state unless it starts threads itself. Every call carries
+/// `now`, the shared-clock time of the call.
 ///
 /// Contract (what the commander relies on):
 ///  - Every command is answered by a report listing it: accepted (queued), or rejected with
@@ -65,6 +66,9 @@ class VehicleDriver {
   virtual void on_resume(TimeNs now) = 0;
   /// Called periodically (the status period) so the driver can report; default: nothing.
   virtual void on_tick(TimeNs now) { (void)now; }
+  /// False while the driver cannot reach its vehicle: the runner then answers commands
+  /// with "unavailable" instead of delivering them. Default: always reachable.
+  virtual bool connected() const { return true; }
 };
 
 }  // namespace drover::ran

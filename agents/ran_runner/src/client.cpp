@@ -1,0 +1,186 @@
+#include "drover/ran_runner/client.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "drover/dds/wire_error.hpp"
+#include "drover/ran_runner/wire.hpp"
+#include "ran_messages.hpp"
+
+namespace drover::ran {
+
+namespace {
+
+msg::SimFaultKind fault_to_wire(SimFault fault) {
+  switch (fault) {
+    case SimFault::stall: return msg::SIM_FAULT_STALL;
+    case SimFault::protective_field: return msg::SIM_FAULT_PROTECTIVE_FIELD;
+    case SimFault::clear_protective_field: return msg::SIM_FAULT_CLEAR_PROTECTIVE_FIELD;
+    case SimFault::battery_failure: return msg::SIM_FAULT_BATTERY_FAILURE;
+    case SimFault::lose_connection: return msg::SIM_FAULT_LOSE_CONNECTION;
+    case SimFault::restore_connection: return msg::SIM_FAULT_RESTORE_CONNECTION;
+  }
+  return msg::SIM_FAULT_STALL;
+}
+
+}  // namespace
+
+RanClient::RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit)
+    : vehicle_id_(std::move(vehicle_id)),
+      ran_agent_(std::move(ran_agent)),
+      history_limit_(std::max<std::size_t>(history_limit, 1)) {}
+
+RanClient::~RanClient() {
+  reader_.reset();  // no callback runs after this
+}
+
+Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participant,
+                                                     std::string vehicle_id,
+                                                     std::string ran_agent,
+                                                     std::size_t history_limit) {
+  if (ran_agent.empty()) ran_agent = ran_agent_id(vehicle_id);
+  register_ran_type_objects();
+  std::unique_ptr<RanClient> client(
+      new RanClient(std::move(vehicle_id), std::move(ran_agent), history_limit));
+  auto commands = CommandClient::create(participant, kServiceArea, kCommandService);
+  if (!commands) return unexpected(commands.error());
+  client->commands_ = std::move(*commands);
+  auto faults = FaultClient::create(participant, kServiceArea, kSimFaultService);
+  if (!faults) return unexpected(faults.error());
+  client->faults_ = std::move(*faults);
+  dds::ReaderOptions options;
+  options.filter_expression = "vehicle_id = %0";
+  options.filter_parameters = {"'" + client->vehicle_id_ + "'"};
+  auto reader = dds::Reader<msg::RanStatus>::create(
+      participant, kStatusTopic,
+      [raw = client.get()](const msg::RanStatus& status) { raw->receive(status); }, options);
+  if (!reader) return unexpected(reader.error());
+  client->reader_ = std::move(*reader);
+  return client;
+}
+
+void RanClient::receive(const msg::RanStatus& wire) {
+  auto status = from_wire(wire);
+  if (!status) {
+    spdlog::warn("status of vehicle '{}' ignored: {}", vehicle_id_, status.error().message);
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    // KEEP_LAST 1 and a late join may skip reports, never reorder them; a repeated sample
+    // (a replaced RAN starting over at 1) starts a new history.
+    if (!history_.empty() && status->sequence <= history_.back().sequence) history_.clear();
+    history_.push_back(std::move(*status));
+    ++received_;
+    while (history_.size() > history_limit_) history_.pop_front();
+  }
+  arrived_.notify_all();
+}
+
+Result<CommandVerdict> RanClient::send(msg::RanCommandRequest request,
+                                       std::chrono::milliseconds timeout) {
+  request.vehicle_id(vehicle_id_);
+  auto reply = commands_->call(std::move(request), timeout, ran_agent_);
+  if (!reply) return unexpected(reply.error());
+  if (auto ok = dds::from_wire(reply->error()); !ok) return unexpected(ok.error());
+  CommandVerdict verdict;
+  if (!reply->state().empty()) {
+    verdict.state = command_state_from_string(reply->state());
+    if (!verdict.state) {
+      return fail(ErrorCode::internal,
+                  fmt::format("RAN '{}' replied with unknown command state '{}'", ran_agent_,
+                              reply->state()));
+    }
+  }
+  verdict.code = reply->code();
+  verdict.reason = reply->reason();
+  return verdict;
+}
+
+Result<CommandVerdict> RanClient::move(const MoveCommand& command, std::chrono::milliseconds timeout) {
+  msg::RanCommandRequest request;
+  request.kind(msg::RAN_COMMAND_MOVE);
+  request.move(to_wire(command));
+  return send(std::move(request), timeout);
+}
+
+Result<CommandVerdict> RanClient::action(const ActionCommand& command,
+                                         std::chrono::milliseconds timeout) {
+  msg::RanCommandRequest request;
+  request.kind(msg::RAN_COMMAND_ACTION);
+  request.action(to_wire(command));
+  return send(std::move(request), timeout);
+}
+
+Status RanClient::cancel(const CommandId& command, std::chrono::milliseconds timeout) {
+  msg::RanCommandRequest request;
+  request.kind(msg::RAN_COMMAND_CANCEL);
+  request.cancel_id(command);
+  auto sent = send(std::move(request), timeout);
+  if (!sent) return unexpected(sent.error());
+  return {};
+}
+
+Status RanClient::pause(std::chrono::milliseconds timeout) {
+  msg::RanCommandRequest request;
+  request.kind(msg::RAN_COMMAND_PAUSE);
+  auto sent = send(std::move(request), timeout);
+  if (!sent) return unexpected(sent.error());
+  return {};
+}
+
+Status RanClient::resume(std::chrono::milliseconds timeout) {
+  msg::RanCommandRequest request;
+  request.kind(msg::RAN_COMMAND_RESUME);
+  auto sent = send(std::move(request), timeout);
+  if (!sent) return unexpected(sent.error());
+  return {};
+}
+
+Status RanClient::inject_fault(SimFault fault, DurationNs duration,
+                               std::chrono::milliseconds timeout) {
+  msg::SimFaultRequest request;
+  request.vehicle_id(vehicle_id_);
+  request.kind(fault_to_wire(fault));
+  request.duration_ns(duration);
+  auto reply = faults_->call(std::move(request), timeout, ran_agent_);
+  if (!reply) return unexpected(reply.error());
+  return dds::from_wire(reply->error());
+}
+
+std::optional<VehicleStatus> RanClient::latest() const {
+  std::lock_guard lock(mutex_);
+  if (history_.empty()) return std::nullopt;
+  return history_.back();
+}
+
+std::optional<VehicleStatus> RanClient::wait_for(
+    const std::function<bool(const VehicleStatus&)>& condition,
+    std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mutex_);
+  // Statuses numbered from `next` on are still to be looked at; the latest one counts.
+  std::uint64_t next = received_ > 0 ? received_ : 1;
+  std::optional<VehicleStatus> found;
+  arrived_.wait_for(lock, timeout, [&] {
+    const std::uint64_t oldest = received_ + 1 - history_.size();
+    for (std::uint64_t number = std::max(next, oldest); number <= received_; ++number) {
+      const VehicleStatus& status = history_[number - oldest];
+      if (condition(status)) {
+        found = status;
+        return true;
+      }
+    }
+    next = received_ + 1;
+    return false;
+  });
+  return found;
+}
+
+std::vector<VehicleStatus> RanClient::history() const {
+  std::lock_guard lock(mutex_);
+  return {history_.begin(), history_.end()};
+}
+
+}  // namespace drover::ran
