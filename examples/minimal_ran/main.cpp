@@ -1,12 +1,19 @@
-// minimal_ran: a straight-line vehicle behind Drover's VehicleDriver interface, driven
-// through a short scenario (a move, a load, a move back, and a command it must refuse)
-// with a sink that prints every status report. Exits 0 when every command ended as
-// expected.
+// minimal_ran: a straight-line vehicle behind Drover's VehicleDriver interface.
+//
+//   minimal_ran VEHICLE_ID [DOMAIN]   runs it as a robot agent node on DDS until SIGINT:
+//                                     commands on drover/ran/command, status on
+//                                     drover/ran/status (agent id ran-VEHICLE_ID)
+//   minimal_ran --self-test           drives it through a short scenario (a move, a load,
+//                                     a move back, two commands it must refuse) with a sink
+//                                     that prints every report; exits 0 when every command
+//                                     ended as expected
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include <drover/ran/vehicle_driver.hpp>
+#include <drover/ran_runner/runner.hpp>
 
 #include "straight_line_driver.hpp"
 
@@ -49,7 +56,7 @@ bool ended_as(const VehicleStatus& status, const char* id, CommandState state) {
 
 }  // namespace
 
-int main() {
+int self_test() {
   StraightLineDriver driver("minimal-1", Pose{0, 0, 0});
   PrintingSink sink;
   TimeNs now = 0;
@@ -73,4 +80,32 @@ int main() {
   std::printf("%s\n", as_expected ? "minimal_ran: all commands ended as expected"
                                   : "minimal_ran: unexpected outcome");
   return as_expected ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  if (argc == 2 && std::string(argv[1]) == "--self-test") return self_test();
+  if (argc < 2 || argc > 3 || argv[1][0] == '-') {
+    std::fprintf(stderr, "usage: minimal_ran VEHICLE_ID [DOMAIN] | minimal_ran --self-test\n");
+    return 2;
+  }
+  RanNodeOptions options;
+  options.vehicle_id = argv[1];
+  if (argc == 3) {
+    char* end = nullptr;
+    const unsigned long domain = std::strtoul(argv[2], &end, 10);
+    if (*end != '\0' || domain > 232) {
+      std::fprintf(stderr, "error: DOMAIN '%s' is not a DDS domain id (0..232)\n", argv[2]);
+      return 2;
+    }
+    options.domain_id = static_cast<std::uint32_t>(domain);
+  }
+  StraightLineDriver driver(options.vehicle_id, Pose{0, 0, 0});
+  // Everything DDS (participant, heartbeat, command service, status topic, SIGINT) is the
+  // runner's: the driver above is all an integrator writes.
+  const auto ran = run_ran_node(driver, options, SharedClock::wall());
+  if (!ran) {
+    std::fprintf(stderr, "error: %s\n", ran.error().message.c_str());
+    return 1;
+  }
+  return 0;
 }

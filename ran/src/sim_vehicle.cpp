@@ -24,6 +24,10 @@ constexpr double kTurnDone = 1e-9;  // rad
 constexpr double kMinStraight = 1e-6;  // m
 /// Distances closer than this are equal (floating-point round-off).
 constexpr double kRoundOff = 1e-9;  // m
+/// A vehicle whose battery runs empty this close to the end of a straight still arrives.
+constexpr double kArrivalSlack = 1e-6;  // m
+/// A battery holding less than this is empty (round-off of the drain).
+constexpr double kEnergyRoundOff = 1e-9;  // Wh
 /// Turns are checked against the motion area at poses at most this far apart; a corner at
 /// radius r then strays at most r (1 - cos(step / 2)) from the sampled outlines
 /// (0.15 mm at r = 1 m), far below the default area tolerance.
@@ -414,7 +418,7 @@ TimeNs SimVehicle::next_event(TimeNs limit) const {
       const double empty_at =
           profile_->distance_at(profile_time(now_)) + energy_wh_ / config_.drain_wh_per_metre;
       if (empty_at < profile_->distance()) {
-        consider(profile_start_ + ceil_ns(profile_->time_at(empty_at)));
+        consider(std::max(now_ + 1, profile_start_ + ceil_ns(profile_->time_at(empty_at))));
       }
     }
   } else if (const auto* rotation = std::get_if<Rotation>(step); rotation && can_move()) {
@@ -480,12 +484,20 @@ void SimVehicle::handle_events() {
       changed();
       replan_ = true;
     }
-    if (battery_empty_ && energy_wh_ > 0) {
+    if (battery_empty_ && energy_wh_ > kEnergyRoundOff) {
       battery_empty_ = false;
       changed();
     }
-    if (profile_ && config_.drain_wh_per_metre > 0 && energy_wh_ <= 0) {
+    // Steps first: a straight that ends with the last watt-hour is done, not failed.
+    if (finish_front_step()) progress = true;
+    // Empty with distance still to go (a vehicle a round-off before the end of its
+    // straight arrives; its next straight then fails).
+    const Step* head = front_step();
+    const auto* straight = head != nullptr ? std::get_if<Straight>(head) : nullptr;
+    if (profile_ && straight != nullptr && config_.drain_wh_per_metre > 0 &&
+        energy_wh_ <= kEnergyRoundOff && head_progress_ < straight->length() - kArrivalSlack) {
       battery_empty_ = true;
+      energy_wh_ = 0;
       speed_ = 0;
       profile_.reset();
       fail_from(0, "battery_empty",
@@ -493,7 +505,6 @@ void SimVehicle::handle_events() {
                             position_.y()));
       progress = true;
     }
-    if (finish_front_step()) progress = true;
     if (profile_ && profile_time(now_) >= profile_->duration()) {
       speed_ = 0;
       profile_.reset();

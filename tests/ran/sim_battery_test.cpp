@@ -96,6 +96,24 @@ TEST(SimBattery, RunsEmptyWithoutGoingBelowZeroAndRecoversByCharging) {
   EXPECT_FALSE(vehicle.status().has_error("battery_empty"));
 }
 
+TEST(SimBattery, ArrivingWithTheLastWattHourIsNoFailure) {
+  const auto world = test::world();
+  SimVehicleConfig config;
+  config.battery_initial_wh = 5;
+  config.drain_wh_per_metre = 1.0;  // exactly the 5 m to B
+  auto vehicle = vehicle_at(world, "A", config);
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "A", "ab", "B", 1.0)));
+  ASSERT_TRUE(vehicle.submit(move(*world, "m2", "B", "bc", "C", 1.0)));
+  ASSERT_TRUE(step_until(
+      vehicle, [&] { return state_of(vehicle, "m2") != CommandState::accepted; }, 10 * kMs,
+      seconds_to_ns(60)));
+  const auto status = vehicle.status();
+  EXPECT_EQ(status.find_command("m1")->state, CommandState::finished);
+  EXPECT_EQ(status.find_command("m2")->state, CommandState::failed);
+  EXPECT_EQ(status.find_command("m2")->code, "battery_empty");
+  EXPECT_NEAR(status.battery.energy_wh, 0, 1e-9);
+}
+
 TEST(SimActions, LoadAndUnloadTakeTheirDurationAndChangeTheLoad) {
   const auto world = test::world();
   SimVehicleConfig config;
