@@ -365,6 +365,9 @@ Result<Journal> Journal::open(const std::filesystem::path& file, std::string_vie
                                    (c->db ? sqlite3_errmsg(c->db) : sqlite3_errstr(rc)) + hint);
   }
   sqlite3_extended_result_codes(c->db, 1);
+  if (sqlite3_db_readonly(c->db, "main") == 1) {  // SQLite falls back to reading silently
+    return fail(ErrorCode::io, c->where() + ": cannot open it for writing (read-only file)");
+  }
   // Exclusive first: entering WAL mode under it keeps the WAL index in process memory and
   // the file locked for as long as the journal is open.
   if (Status ok = c->exec("PRAGMA locking_mode = EXCLUSIVE", "set the locking mode"); !ok) {

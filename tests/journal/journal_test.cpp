@@ -282,6 +282,19 @@ TEST(Journal, UnwritablePathIsAnIoError) {
       << directory.error().message;
 }
 
+TEST(Journal, ReadOnlyFileIsAnIoError) {
+  if (::geteuid() == 0) GTEST_SKIP() << "file permissions do not bind root";
+  TempDir dir;
+  const fs::path file = dir / "j.db";
+  ASSERT_TRUE(Journal::open(file, kKey));
+  fs::permissions(file, fs::perms::owner_read);
+  const auto journal = Journal::open(file, kKey);
+  ASSERT_FALSE(journal);
+  EXPECT_EQ(journal.error().code, ErrorCode::io);
+  EXPECT_EQ(journal.error().message,
+            "journal " + file.string() + ": cannot open it for writing (read-only file)");
+}
+
 TEST(Journal, NotADatabaseIsAParseError) {
   TempDir dir;
   const fs::path file = dir / "garbage.db";
