@@ -20,7 +20,7 @@ void WindowSearch::begin(const SearchInput& input) {
     entity_first_.assign(entities, 0);
     entity_count_.assign(entities, 0);
   }
-  const std::size_t blocks = input.legs.size() * (graph.vertex_count() + graph.arc_count());
+  const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
     block_first_.resize(blocks, 0);
@@ -46,18 +46,15 @@ std::uint32_t WindowSearch::windows_of(const SearchInput& input, EntityIndex ent
 }
 
 std::uint32_t WindowSearch::states_of(const SearchInput& input, std::uint32_t layer,
-                                      std::uint32_t node) {
-  const RoutingGraph& graph = *input.graph;
-  const std::size_t vertices = graph.vertex_count();
-  const std::size_t key = layer * (vertices + graph.arc_count()) + node;
+                                      EntityIndex vertex) {
+  const std::size_t key = layer * input.graph->vertex_count() + vertex;
   if (block_stamp_[key] != generation_) {
     block_stamp_[key] = generation_;
-    const EntityIndex entity = node < vertices ? node : graph.arc(node - vertices).edge;
     std::uint32_t count = 0;
-    const std::uint32_t first_window = windows_of(input, entity, count);
+    const std::uint32_t first_window = windows_of(input, vertex, count);
     block_first_[key] = static_cast<std::uint32_t>(states_.size());
     for (std::uint32_t i = 0; i < count; ++i) {
-      states_.push_back(State{0, kForever, kNone, node, first_window + i,
+      states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
                               static_cast<std::uint16_t>(layer), false});
     }
   }
@@ -72,39 +69,57 @@ DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
 }
 
 void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
-                           std::uint32_t parent, DurationNs estimate) {
+                           std::uint32_t parent, std::uint32_t arc, TimeNs edge_entry,
+                           DurationNs estimate) {
   State& s = states_[state];
   if (s.closed || ready >= s.ready) return;
   s.entry = entry;
   s.ready = ready;
   s.parent = parent;
+  s.arc = arc;
+  s.edge_entry = edge_entry;
   open_.push(OpenEntry{ready + estimate, ready, sequence_++, state, kNone});
 }
 
-void WindowSearch::enter(const SearchInput& input, std::uint32_t from, std::uint32_t node,
-                         EntityIndex entity, DurationNs clearance, DurationNs travel,
+void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
                          DurationNs estimate, SearchOutcome& outcome) {
+  const Arc& a = input.graph->arc(arc);
+  const DurationNs travel = input.traversal->travel(arc);
+  const DurationNs clearance = input.traversal->clearance(arc);
   const State current = states_[from];
-  // The vehicle must be gone from its window, tail included, before it ends.
-  const TimeNs latest = windows_[current.window].end - clearance;
-  if (current.ready > latest) return;
-  std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, entity, count);
-  const auto begin = windows_.begin() + first;
-  const auto usable = std::partition_point(
-      begin, begin + count, [&](const Interval& w) { return w.end <= current.ready; });
+  // The vehicle must be off the vertex, tail included, before its window ends.
+  const TimeNs latest_onto_edge = windows_[current.window].end - clearance;
+  if (current.ready > latest_onto_edge) return;
+
+  std::uint32_t edge_count = 0, vertex_count = 0;
+  const std::uint32_t edge_first = windows_of(input, a.edge, edge_count);
+  const std::uint32_t vertex_first = windows_of(input, a.to, vertex_count);
+  const auto later_than = [this](std::uint32_t first, std::uint32_t count, TimeNs t) {
+    const auto begin = windows_.begin() + first;
+    return static_cast<std::uint32_t>(
+        std::partition_point(begin, begin + count, [t](const Interval& w) { return w.end <= t; }) -
+        begin);
+  };
   std::uint32_t block = kNone;
-  for (auto it = usable; it != begin + count && it->start <= latest; ++it) {
-    const TimeNs enter_at = std::max(current.ready, it->start);
-    const TimeNs ready = enter_at + travel;
-    // On an arc the vehicle must also be able to leave before the window ends.
-    if (travel > 0 && ready + clearance > it->end) continue;
-    if (ready > input.deadline) {
-      outcome.horizon_cut = true;
-      break;  // later windows are later still
+  for (std::uint32_t i = later_than(edge_first, edge_count, current.ready); i < edge_count; ++i) {
+    const Interval edge = windows_[edge_first + i];
+    if (edge.start > latest_onto_edge) break;
+    const TimeNs onto_edge = std::max(current.ready, edge.start);
+    const TimeNs earliest_arrival = onto_edge + travel;
+    const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
+    if (earliest_arrival > latest_arrival) continue;
+    for (std::uint32_t j = later_than(vertex_first, vertex_count, earliest_arrival);
+         j < vertex_count; ++j) {
+      const Interval window = windows_[vertex_first + j];
+      if (window.start > latest_arrival) break;
+      const TimeNs arrival = std::max(earliest_arrival, window.start);
+      if (arrival > input.deadline) {
+        outcome.horizon_cut = true;
+        break;  // later windows are later still
+      }
+      if (block == kNone) block = states_of(input, current.layer, a.to);
+      improve(block + j, arrival, arrival, from, arc, onto_edge, estimate);
     }
-    if (block == kNone) block = states_of(input, current.layer, node);
-    improve(block + static_cast<std::uint32_t>(it - begin), enter_at, ready, from, estimate);
   }
 }
 
@@ -117,55 +132,42 @@ bool WindowSearch::completes(const SearchInput& input, const State& state) const
 SearchOutcome WindowSearch::run(const SearchInput& input) {
   begin(input);
   SearchOutcome outcome;
-  const RoutingGraph& graph = *input.graph;
-  const Traversal& traversal = *input.traversal;
-  const auto vertices = static_cast<std::uint32_t>(graph.vertex_count());
-
   std::uint32_t count = 0;
   const std::uint32_t first = windows_of(input, input.start, count);
   if (count == 0 || windows_[first].start != input.start_time) return outcome;
   outcome.start_free = true;
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
-  improve(states_of(input, 0, input.start), input.start_time, input.start_time, kNone,
-          start_estimate);
+  improve(states_of(input, 0, input.start), input.start_time, input.start_time, kNone, kNone,
+          0, start_estimate);
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
-    if (top.arc != kNone) {  // a deferred move onto an arc: now look at its windows
-      const ArcIndex a = top.arc;
-      enter(input, top.state, vertices + a, graph.arc(a).edge, traversal.clearance(a),
-            traversal.travel(a), top.f - top.ready, outcome);
+    if (top.arc != kNone) {  // a deferred move: now look at the windows
+      drive(input, top.state, top.arc, top.f - top.ready, outcome);
       continue;
     }
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
     popped.closed = true;
     const State current = popped;  // states_ may grow below
-
-    if (current.node >= vertices) {  // on an arc: next is its destination vertex
-      const ArcIndex a = current.node - vertices;
-      const EntityIndex to = graph.arc(a).to;
-      enter(input, top.state, to, to, traversal.clearance(a), 0,
-            estimate(input, current.layer, to), outcome);
-      continue;
-    }
-    if (current.node == input.legs[current.layer].stop &&
+    if (current.vertex == input.legs[current.layer].stop &&
         current.layer + 1u == input.legs.size() && completes(input, current)) {
       goal_state_ = top.state;
       outcome.found = true;
       return outcome;
     }
-    expand_vertex(input, top.state, current, outcome);
+    expand(input, top.state, current, outcome);
   }
   return outcome;
 }
 
-void WindowSearch::expand_vertex(const SearchInput& input, std::uint32_t index,
-                                 const State& current, SearchOutcome& outcome) {
+void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const State& current,
+                          SearchOutcome& outcome) {
   const RoutingGraph& graph = *input.graph;
   const Traversal& traversal = *input.traversal;
-  const EntityIndex vertex = current.node;
+  const EntityIndex vertex = current.vertex;
+  const TimeNs window_end = windows_[current.window].end;
   const Leg& leg = input.legs[current.layer];
   if (vertex == leg.stop && current.layer + 1u < input.legs.size()) {
     // Make the stop: stay for the dwell, then head for the next one from here.
@@ -173,16 +175,16 @@ void WindowSearch::expand_vertex(const SearchInput& input, std::uint32_t index,
     const DurationNs next_estimate = estimate(input, current.layer + 1u, vertex);
     if (ready > input.deadline) {
       outcome.horizon_cut = true;
-    } else if (ready < windows_[current.window].end && next_estimate != kUnreachable) {
+    } else if (ready < window_end && next_estimate != kUnreachable) {
       const std::uint32_t block = states_of(input, current.layer + 1u, vertex);
       improve(block + (current.window - entity_first_[vertex]), current.entry, ready, index,
-              next_estimate);
+              kNone, 0, next_estimate);
     }
   }
-  // Moves onto the arcs are deferred: keyed by the earliest arrival they could give.
+  // Moves along the arcs are deferred, keyed by the earliest arrival they could give.
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
     if (!traversal.usable_arc(a)) continue;
-    if (current.ready + traversal.clearance(a) > windows_[current.window].end) continue;
+    if (current.ready + traversal.clearance(a) > window_end) continue;
     const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
     if (arc_estimate == kUnreachable) continue;
     const TimeNs earliest = current.ready + traversal.travel(a);
@@ -197,7 +199,6 @@ void WindowSearch::expand_vertex(const SearchInput& input, std::uint32_t index,
 Route WindowSearch::route(const SearchInput& input) const {
   const RoutingGraph& graph = *input.graph;
   const Traversal& traversal = *input.traversal;
-  const auto vertices = static_cast<std::uint32_t>(graph.vertex_count());
   std::vector<std::uint32_t> chain;
   for (std::uint32_t s = goal_state_; s != kNone; s = states_[s].parent) chain.push_back(s);
   std::reverse(chain.begin(), chain.end());
@@ -207,21 +208,19 @@ Route WindowSearch::route(const SearchInput& input) const {
     const State& state = states_[chain[i]];
     if (i > 0) {
       const State& previous = states_[chain[i - 1]];
-      if (previous.node == state.node) {  // a stop was made here; the step goes on
+      if (state.arc == kNone) {  // a stop was made at the previous state; the step goes on
         route.stop_steps.push_back(route.steps.size() - 1);
         route.stop_arrivals.push_back(previous.ready);
         continue;
       }
-      const ArcIndex arc = (previous.node >= vertices ? previous.node : state.node) - vertices;
-      route.steps.back().window.end = state.entry + traversal.clearance(arc);
-    }
-    EntityIndex entity = state.node;
-    if (state.node >= vertices) {
-      const Arc& arc = graph.arc(state.node - vertices);
-      entity = arc.edge;
+      const Arc& arc = graph.arc(state.arc);
+      const DurationNs clearance = traversal.clearance(state.arc);
+      route.steps.back().window.end = state.edge_entry + clearance;
+      route.steps.push_back(
+          topology::RouteStep{arc.edge, Interval{state.edge_entry, state.entry + clearance}});
       route.distance += arc.length;
     }
-    route.steps.push_back(topology::RouteStep{entity, Interval{state.entry, 0}});
+    route.steps.push_back(topology::RouteStep{state.vertex, Interval{state.entry, 0}});
   }
   const State& goal = states_[goal_state_];
   const DurationNs hold = input.legs.back().dwell;

@@ -1,15 +1,16 @@
 #pragma once
-// The CARP search: A* over (stop layer, node, free window) states, where a node is a vertex
-// or an arc (an edge in one direction), ordered by the earliest time the vehicle can leave
-// the node's entity plus the exact reservation-free time still to go.
+// The CARP search: A* over (stop layer, vertex, free window) states, ordered by the earliest
+// time the vehicle can leave the vertex plus the exact reservation-free time still to go.
 //
-// A state (k, n, w) means: heading for stop k, the vehicle is on n's entity inside its free
-// window w, entered at `entry` and able to leave from `ready` on (entry, or entry + travel
-// time for an arc, or the arrival plus the dwell just after a stop). Leaving at y into the
-// next entity's window w' needs y >= ready, y in w', and y + clearance <= end of w (the
-// vehicle spans both for the clearance time). The earliest such y dominates every later one,
-// because the vehicle may wait inside w'. Memory is reused between searches: stamps instead
-// of clears, one arena for all windows and states.
+// A state (k, v, w) means: heading for stop k, the vehicle is on vertex v inside its free
+// window w, entered at `entry` and able to leave from `ready` on (entry, or entry + the
+// dwell just after a stop). Driving arc a = (v, u) means: enter a's edge at y inside one of
+// its free windows e, with y >= ready and y + clearance <= end of w (the vehicle spans both
+// for the clearance time); leave it at z >= y + travel inside a free window w' of u, with
+// z + clearance <= end of e (waiting on the edge is allowed). The earliest y and z dominate
+// later ones, because the vehicle may wait inside e and w'. An arc has a single source
+// vertex, so edges need no states of their own. Memory is reused between searches: stamps
+// instead of clears, one arena for all windows and states.
 
 #include <cstdint>
 #include <span>
@@ -56,17 +57,19 @@ class WindowSearch {
 
  private:
   struct State {
-    TimeNs entry;
+    TimeNs entry;            // when the vehicle starts entering the vertex
     TimeNs ready;            // kForever: not reached yet
+    TimeNs edge_entry;       // when it entered the edge it came by
     std::uint32_t parent;
-    std::uint32_t node;      // vertex index, or vertex_count + arc index
+    std::uint32_t arc;       // the arc it came by; kNone at the start or after a stop
+    std::uint32_t vertex;
     std::uint32_t window;    // index into windows_
     std::uint16_t layer;
     bool closed;
   };
-  /// An open state, or (arc != kNone) a deferred move from a closed vertex state onto an
-  /// arc, keyed by the earliest the move could get there: the arc's windows are looked up
-  /// only if the search ever gets that far, which spares most free-window queries.
+  /// An open state, or (arc != kNone) a deferred move from a closed state along an arc,
+  /// keyed by the earliest the move could arrive: the windows of the arc's edge and
+  /// destination are looked up only if the search ever gets that far.
   struct OpenEntry {
     TimeNs f;
     TimeNs ready;
@@ -87,19 +90,19 @@ class WindowSearch {
   /// The free windows of `entity` from the start time on: indices [first, first + count).
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
                            std::uint32_t& count);
-  /// The index of the state for window 0 of (layer, node); its other windows follow.
-  std::uint32_t states_of(const SearchInput& input, std::uint32_t layer, std::uint32_t node);
+  /// The index of the state for window 0 of (layer, vertex); its other windows follow.
+  std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
+                          topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
-  /// Moves from state `from` into every fitting window of `node` (entity `entity`).
-  void enter(const SearchInput& input, std::uint32_t from, std::uint32_t node,
-             topology::EntityIndex entity, DurationNs clearance, DurationNs travel,
-             DurationNs estimate, SearchOutcome& outcome);
+  /// Drives arc `arc` from state `from` into every window of its destination it can reach.
+  void drive(const SearchInput& input, std::uint32_t from, ArcIndex arc, DurationNs estimate,
+             SearchOutcome& outcome);
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
-               DurationNs estimate);
+               std::uint32_t arc, TimeNs edge_entry, DurationNs estimate);
   bool completes(const SearchInput& input, const State& state) const;
-  void expand_vertex(const SearchInput& input, std::uint32_t index, const State& current,
-                     SearchOutcome& outcome);
+  void expand(const SearchInput& input, std::uint32_t index, const State& current,
+              SearchOutcome& outcome);
 
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;

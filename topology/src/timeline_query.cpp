@@ -11,6 +11,16 @@
 
 namespace drover::topology {
 
+namespace {
+
+/// a == b, testing the last character first: the agent ids of a fleet often share a long
+/// prefix ("agv-017", "agv-018"), and this runs for every reservation a planner looks at.
+bool same_agent(const std::string& a, std::string_view b) {
+  return a.size() == b.size() && (b.empty() || a.back() == b.back()) && a == b;
+}
+
+}  // namespace
+
 void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                                       TimeNs until, std::vector<Interval>& out,
                                       bool count_locks) const {
@@ -30,9 +40,12 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
       for (const Lock& lock : t.locks) block(lock.window.start, lock.window.end);
     }
     for (const Reservation& r : t.reservations) {
-      if (r.agent == agent) continue;
-      // Nobody may come before a holder: everything up to its end is taken.
-      block(Impl::is_held(*this, r) ? from : r.window.start, r.window.end);
+      if (same_agent(r.agent, agent)) continue;
+      // Nobody may come before a holder: everything up to its end is taken. (Most
+      // reservations' origins are not held at all: that is checked first, inline.)
+      const bool held = r.window.start > from && r.origin < held_.size() && held_[r.origin] &&
+                        Impl::is_held(*this, r);
+      block(held ? from : r.window.start, r.window.end);
     }
   };
   block_timeline(entity);
