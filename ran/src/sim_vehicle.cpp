@@ -464,8 +464,8 @@ void SimVehicle::advance_continuous(TimeNs to) {
     auto& running = std::get<Operation>(tasks_.front().steps.front());
     running.elapsed += to - now_;
     if (operation->kind == ActionKind::charge) {
-      energy_wh_ = std::min(operation->charge_target_wh,
-                            energy_wh_ + config_.charge_wh_per_second * seconds);
+      energy_wh_ = std::max(energy_wh_, std::min(operation->charge_target_wh,
+                                                 energy_wh_ + config_.charge_wh_per_second * seconds));
     }
   }
 }
