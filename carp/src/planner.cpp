@@ -120,6 +120,7 @@ struct Planner::Impl {
   HeuristicCache heuristics;
   WindowSearch search;
   std::vector<Leg> legs;
+  std::vector<Interval> goal_windows;
 
   Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
       : graph(std::move(g)), options(o), heuristics(o.heuristic_tables) {}
@@ -218,11 +219,35 @@ struct Planner::Impl {
     return std::nullopt;
   }
 
+  /// An open-ended last stop needs a free window that never ends; without one no search
+  /// can succeed, so this is checked first. \return why there is none, if so.
+  std::optional<PlanError> check_goal_held(const TimelineSet& timelines,
+                                           const PlanRequest& request) {
+    const Stop& last = request.stops.back();
+    if (last.dwell) return std::nullopt;
+    const auto open_ended = [](const std::vector<Interval>& windows) {
+      return !windows.empty() && windows.back().end == kForever;
+    };
+    goal_windows.clear();
+    timelines.append_free_windows(last.vertex, request.agent, request.start_time, kForever,
+                                  goal_windows);
+    if (open_ended(goal_windows)) return std::nullopt;
+    const TimeNs from = goal_windows.empty() ? request.start_time : goal_windows.back().end;
+    goal_windows.clear();
+    timelines.append_free_windows(last.vertex, request.agent, request.start_time, kForever,
+                                  goal_windows, false);
+    return error(open_ended(goal_windows) ? PlanFailure::locked : PlanFailure::no_window,
+                 fmt::format("the last stop {} is never free for good (open-ended) from {} on: {}",
+                             vertex_name(last.vertex), time_text(from),
+                             forever_blocker_text(topology(), timelines, last.vertex,
+                                                  request.agent, from)));
+  }
+
   /// Explains a search that found nothing (only called then, so it may take its time).
   PlanError diagnose(const TimelineSet& timelines, const PlanRequest& request,
                      SearchInput input, const SearchOutcome& outcome) {
     const std::string& agent = request.agent;
-    std::vector<Interval> with_locks, without_locks;
+    std::vector<Interval> without_locks;
     if (!outcome.start_free) {
       timelines.append_free_windows(request.start, agent, request.start_time,
                                     request.start_time + 1, without_locks, false);
@@ -233,22 +258,6 @@ struct Planner::Impl {
                                vertex_name(request.start), time_text(request.start_time), why));
     }
     const EntityIndex goal = request.stops.back().vertex;
-    if (!request.stops.back().dwell) {
-      const auto open_ended = [](const std::vector<Interval>& windows) {
-        return !windows.empty() && windows.back().end == kForever;
-      };
-      timelines.append_free_windows(goal, agent, request.start_time, kForever, with_locks);
-      timelines.append_free_windows(goal, agent, request.start_time, kForever, without_locks,
-                                    false);
-      if (!open_ended(with_locks)) {
-        const TimeNs from = with_locks.empty() ? request.start_time : with_locks.back().end;
-        return error(open_ended(without_locks) ? PlanFailure::locked : PlanFailure::no_window,
-                     fmt::format("the last stop {} is never free for good (open-ended) from "
-                                 "{} on: {}",
-                                 vertex_name(goal), time_text(from),
-                                 forever_blocker_text(topology(), timelines, goal, agent, from)));
-      }
-    }
     input.count_locks = false;
     if (any_lock(timelines) && search.run(input).found) {
       return error(PlanFailure::locked,
@@ -275,6 +284,7 @@ struct Planner::Impl {
     if (auto bad = prepare_legs(*traversal, class_id, request)) {
       return unexpected(std::move(*bad));
     }
+    if (auto bad = check_goal_held(timelines, request)) return unexpected(std::move(*bad));
     SearchInput input;
     input.graph = graph.get();
     input.traversal = traversal;
