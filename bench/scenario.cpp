@@ -1,5 +1,6 @@
 #include "bench/scenario.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <fstream>
 #include <sstream>
@@ -100,7 +101,7 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
     }
     tasks.push_back(std::move(task));
   }
-  if (!header_seen) return bad(line_number, "empty file (expected \"version 1\")");
+  if (!header_seen) return bad(std::max(line_number, 1), "empty file (expected \"version 1\")");
   return tasks;
 }
 

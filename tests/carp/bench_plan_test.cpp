@@ -1,0 +1,162 @@
+// `drover bench plan`: runs the built binary on a small map and checks the JSON line, the
+// paths file and the errors for bad input.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_all(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string quoted(const std::string& text) {
+  std::string q = "'";
+  for (const char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct CommandRun {
+  int exit_code = -1;  ///< -1: did not exit normally (a crash)
+  std::string out;
+  std::string err;
+};
+
+// Two rows joined at both ends around a wall: every agent has exactly two ways round.
+constexpr const char* kMap =
+    "type octile\nheight 3\nwidth 6\nmap\n"
+    "......\n"
+    ".@@@@.\n"
+    "......\n";
+
+class BenchPlan : public ::testing::Test {
+ protected:
+  BenchPlan()
+      : dir_(fs::temp_directory_path() / ("drover-bench-plan-test-" + std::to_string(::getpid()))) {
+    fs::create_directories(dir_);
+    write("ring.map", kMap);
+    write("ring.scen",
+          "version 1\n"
+          "0\tring.map\t6\t3\t0\t0\t5\t2\t7\n"
+          "0\tring.map\t6\t3\t5\t0\t0\t2\t7\n"
+          "0\tring.map\t6\t3\t2\t2\t3\t0\t7\n");
+  }
+  ~BenchPlan() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return (dir_ / name).string();
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  CommandRun bench_plan(const std::vector<std::string>& arguments) {
+    const char* binary_dir = std::getenv("DROVER_BINARY_DIR");
+    const fs::path binary = fs::path(binary_dir ? binary_dir : "build") / "bin" / "drover";
+    std::string command = quoted(binary.string()) + " bench plan";
+    for (const auto& argument : arguments) command += " " + quoted(argument);
+    command += " >" + quoted(path("stdout")) + " 2>" + quoted(path("stderr"));
+    const int status = std::system(command.c_str());
+    CommandRun run;
+    if (status != -1 && WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
+    run.out = read_all(path("stdout"));
+    run.err = read_all(path("stderr"));
+    return run;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(BenchPlan, PrintsOneJsonLineAndWritesEveryAgentsSteps) {
+  const CommandRun run = bench_plan({"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents",
+                              "3", "--paths", path("paths.jsonl")});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_EQ(run.out.find('\n'), run.out.size() - 1) << "exactly one line: " << run.out;
+  const auto line = nlohmann::json::parse(run.out);
+  EXPECT_EQ(line["map"], "ring.map");
+  EXPECT_EQ(line["agents"], 3);
+  EXPECT_EQ(line["astar_found"], 3);
+  EXPECT_EQ(line["planned"].get<int>() + line["failed"].get<int>(), 3);
+  EXPECT_GE(line["planned"].get<int>(), 1);
+  EXPECT_GT(line["astar_seconds"].get<double>(), 0);
+  EXPECT_DOUBLE_EQ(line["ratio_to_astar"].get<double>(),
+                   line["plan_seconds"].get<double>() / line["astar_seconds"].get<double>());
+
+  // The paths: one line per agent, from its start at time 0 to its goal held for good.
+  const std::vector<std::pair<std::string, std::string>> tasks{
+      {"0,0", "5,2"}, {"5,0", "0,2"}, {"2,2", "3,0"}};
+  std::istringstream paths(read_all(path("paths.jsonl")));
+  double sum_of_costs = 0;
+  int planned = 0;
+  std::string text;
+  for (int agent = 0; agent < 3; ++agent) {
+    ASSERT_TRUE(std::getline(paths, text)) << "no line for agent " << agent;
+    const auto entry = nlohmann::json::parse(text);
+    EXPECT_EQ(entry["agent"], agent);
+    const auto& steps = entry["steps"];
+    if (steps.empty()) {
+      EXPECT_FALSE(entry["error"].get<std::string>().empty());
+      continue;
+    }
+    ++planned;
+    EXPECT_EQ(steps.front()["entity"], tasks[agent].first);
+    EXPECT_EQ(steps.front()["enter"], 0.0);
+    EXPECT_EQ(steps.back()["entity"], tasks[agent].second);
+    EXPECT_TRUE(steps.back()["leave"].is_null());
+    for (std::size_t i = 1; i < steps.size(); ++i) {
+      EXPECT_LE(steps[i]["enter"].get<double>(), steps[i - 1]["leave"].get<double>());
+      EXPECT_GE(steps[i]["enter"].get<double>(), steps[i - 1]["enter"].get<double>());
+    }
+    sum_of_costs += steps.back()["enter"].get<double>();
+  }
+  EXPECT_FALSE(std::getline(paths, text)) << "one line per agent only";
+  EXPECT_EQ(line["planned"], planned);
+  EXPECT_DOUBLE_EQ(line["sum_of_costs"].get<double>(), sum_of_costs);
+}
+
+TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
+  write("short.scen", "version 1\n0\tring.map\t6\t3\t0\t0\t5\n");
+  write("wall.scen", "version 1\n0\tring.map\t6\t3\t1\t1\t5\t2\t7\n");
+  const struct {
+    std::vector<std::string> arguments;
+    std::string message;
+  } cases[] = {
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "4"},
+       "but the scenario has only 3 tasks"},
+      {{"--map", path("ring.map"), "--scen", path("short.scen"), "--agents", "1"},
+       path("short.scen") + ":2: expected 9 fields"},
+      {{"--map", path("ring.map"), "--scen", path("wall.scen"), "--agents", "1"},
+       path("wall.scen") + ":2: start cell is not a passable cell"},
+      {{"--map", path("missing.map"), "--scen", path("ring.scen"), "--agents", "1"},
+       path("missing.map")},
+      {{"--map", path("ring.map"), "--scen", path("missing.scen"), "--agents", "1"},
+       path("missing.scen")},
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "0"}, "--agents"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.message);
+    const CommandRun run = bench_plan(c.arguments);
+    EXPECT_EQ(run.exit_code, 2);
+    EXPECT_EQ(run.out, "");
+    EXPECT_NE(run.err.find(c.message), std::string::npos) << run.err;
+  }
+}
+
+}  // namespace
