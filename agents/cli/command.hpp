@@ -22,6 +22,9 @@ struct CommandContext {
 /// `drover topology ...` (validate and friends).
 void add_topology_commands(CLI::App& app, CommandContext& context);
 
+/// `drover topology-agent`: a topology agent process (agents/topology_agent/).
+void add_topology_agent_command(CLI::App& app, CommandContext& context);
+
 /// `drover ran-sim ...`: a simulated vehicle as a RAN process (agents/ran_runner/cli/).
 void add_ran_commands(CLI::App& app, CommandContext& context);
 

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
 
   CommandContext context;
   add_topology_commands(app, context);
+  add_topology_agent_command(app, context);
   add_ran_commands(app, context);
   drover::bench::add_bench_commands(app, context);
 

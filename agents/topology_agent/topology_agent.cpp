@@ -1,0 +1,468 @@
+#include "agents/topology_agent/topology_agent.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <set>
+#include <tuple>
+
+#include <spdlog/spdlog.h>
+
+#include "agents/topology_agent/wire.hpp"
+#include "drover/dds/shutdown_signal.hpp"
+#include "drover/dds/wire_error.hpp"
+
+namespace drover::topology_agent {
+
+namespace {
+
+/// Sends a reply and logs when it could not go out (the requester went away).
+template <class Rep>
+void send_reply(dds::ReplyHandle<Rep>& handle, Rep reply) {
+  if (auto sent = handle.send(std::move(reply)); !sent) {
+    spdlog::warn("reply to '{}' not sent: {}", handle.requester(), sent.error().message);
+  }
+}
+
+template <class Rep>
+void send_error(dds::ReplyHandle<Rep>& handle, const Error& error) {
+  spdlog::info("request of '{}' rejected: {}", handle.requester(), error.message);
+  if (auto sent = handle.send_error(error); !sent) {
+    spdlog::warn("error reply to '{}' not sent: {}", handle.requester(), sent.error().message);
+  }
+}
+
+void send_status(dds::ReplyHandle<msg::StatusReply>& handle, const Status& status) {
+  if (!status) return send_error(handle, status.error());
+  send_reply(handle, msg::StatusReply{});
+}
+
+}  // namespace
+
+Result<std::unique_ptr<TopologyAgent>> TopologyAgent::create(topology::Topology topology,
+                                                             SharedClock clock,
+                                                             TopologyAgentOptions options) {
+  std::vector<bool> owned(topology.entity_count(), options.partition.empty());
+  std::size_t owned_count = options.partition.empty() ? topology.entity_count() : 0;
+  if (!options.partition.empty()) {
+    for (topology::EntityIndex entity = 0; entity < topology.entity_count(); ++entity) {
+      if (topology.partition(entity) != options.partition) continue;
+      owned[entity] = true;
+      ++owned_count;
+    }
+  }
+  if (owned_count == 0) {
+    std::string known;
+    for (const auto& name : topology.partitions()) known += (known.empty() ? "" : ", ") + name;
+    return fail(ErrorCode::invalid_argument,
+                options.partition.empty()
+                    ? "topology '" + topology.name() + "' has no entity"
+                    : "partition '" + options.partition + "' owns no entity of topology '" +
+                          topology.name() + "' (its partitions: " + known + ")");
+  }
+  std::optional<Journal> journal;
+  std::optional<topology::TimelineSet> timelines;
+  if (options.journal_file.empty()) {
+    timelines.emplace(topology.conflict_sets(), std::move(owned));
+  } else {
+    auto opened = Journal::open(options.journal_file, journal_key(topology, options.partition));
+    if (!opened) return unexpected(opened.error());
+    journal.emplace(std::move(*opened));
+    auto restored = restore_timelines(*journal, topology.conflict_sets(), std::move(owned));
+    if (!restored) return unexpected(restored.error());
+    timelines.emplace(std::move(*restored));
+  }
+  auto participant = dds::Participant::create(options.participant);
+  if (!participant) return unexpected(participant.error());
+  std::unique_ptr<TopologyAgent> agent(new TopologyAgent(std::move(topology), clock, std::move(options),
+                                                         owned_count, std::move(*timelines),
+                                                         std::move(journal), std::move(*participant)));
+  if (auto started = agent->start(); !started) return unexpected(started.error());
+  return agent;
+}
+
+TopologyAgent::TopologyAgent(topology::Topology topology, SharedClock clock, TopologyAgentOptions options,
+                             std::size_t owned_count, topology::TimelineSet timelines,
+                             std::optional<Journal> journal, std::unique_ptr<dds::Participant> participant)
+    : topology_(std::move(topology)),
+      clock_(clock),
+      options_(std::move(options)),
+      owned_count_(owned_count),
+      participant_(std::move(participant)),
+      timelines_(std::move(timelines)),
+      journal_(std::move(journal)),
+      published_versions_(topology_.entity_count(), 0) {}
+
+std::vector<std::string> TopologyAgent::served_partitions() const {
+  if (!options_.partition.empty()) return {options_.partition};
+  return topology_.partitions();
+}
+
+Status TopologyAgent::start() {
+  auto descriptions = dds::Writer<msg::EntityDescription>::create(*participant_, kEntityTopic);
+  if (!descriptions) return unexpected(descriptions.error());
+  description_writer_ = std::move(*descriptions);
+  auto timelines = dds::Writer<msg::TimelineState>::create(*participant_, kTimelineTopic);
+  if (!timelines) return unexpected(timelines.error());
+  timeline_writer_ = std::move(*timelines);
+  auto notices = dds::Writer<msg::ReservationNotice>::create(*participant_, kNoticeTopic,
+                                                             dds::TopicQos::events());
+  if (!notices) return unexpected(notices.error());
+  notice_writer_ = std::move(*notices);
+
+  {
+    std::lock_guard lock(mutex_);
+    for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
+      if (!timelines_.owns(entity)) continue;
+      if (auto written = description_writer_->write(to_wire_description(topology_, entity)); !written) {
+        return unexpected(written.error());
+      }
+      const auto& timeline = timelines_.timeline(entity);
+      if (auto written = timeline_writer_->write(to_wire_timeline(topology_, agent_id(), entity, timeline));
+          !written) {
+        return unexpected(written.error());
+      }
+      published_versions_[entity] = timeline.version;
+    }
+  }
+
+  expiry_thread_ = std::thread([this] { run_expiry(); });
+
+  // Every handler takes the one mutex: requests are applied one at a time, whole.
+  auto serve = [this]<class Req, class Rep>(Server<Req, Rep>& server, const char* service,
+                                            void (TopologyAgent::*handler)(const Req&, dds::ReplyHandle<Rep>))
+      -> Status {
+    auto created = dds::ServiceServer<Req, Rep>::create(
+        *participant_, kServiceArea, service,
+        [this, handler](const Req& request, dds::ReplyHandle<Rep> reply) {
+          (this->*handler)(request, std::move(reply));
+        });
+    if (!created) return unexpected(created.error());
+    server = std::move(*created);
+    return {};
+  };
+  for (auto status : {serve(prepare_server_, "reserve_prepare", &TopologyAgent::on_prepare),
+                      serve(commit_server_, "reserve_commit", &TopologyAgent::on_commit),
+                      serve(abort_server_, "reserve_abort", &TopologyAgent::on_abort),
+                      serve(allocate_server_, "allocate", &TopologyAgent::on_allocate),
+                      serve(release_server_, "release", &TopologyAgent::on_release),
+                      serve(lock_server_, "lock", &TopologyAgent::on_lock),
+                      serve(unlock_server_, "unlock", &TopologyAgent::on_unlock),
+                      serve(delay_server_, "delay", &TopologyAgent::on_delay),
+                      serve(cancel_server_, "cancel_route", &TopologyAgent::on_cancel_route)}) {
+    if (!status) return status;
+  }
+
+  dds::HeartbeatOptions beat;
+  beat.kind = "topology";
+  beat.owns = served_partitions();
+  auto heartbeat = dds::HeartbeatPublisher::create(*participant_, clock_, std::move(beat));
+  if (!heartbeat) return unexpected(heartbeat.error());
+  heartbeat_ = std::move(*heartbeat);
+  return {};
+}
+
+TopologyAgent::~TopologyAgent() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  expiry_wake_.notify_all();
+  if (expiry_thread_.joinable()) expiry_thread_.join();
+  // Servers first, so that no handler runs any more; then the queued requests.
+  prepare_server_.reset();
+  commit_server_.reset();
+  abort_server_.reset();
+  allocate_server_.reset();
+  release_server_.reset();
+  lock_server_.reset();
+  unlock_server_.reset();
+  delay_server_.reset();
+  cancel_server_.reset();
+  std::lock_guard lock(mutex_);
+  for (auto& [key, handle] : waiting_replies_) {
+    send_error(handle, Error{ErrorCode::unavailable, "topology agent '" + agent_id() + "' shut down"});
+  }
+  waiting_replies_.clear();
+}
+
+Result<topology::EntityIndex> TopologyAgent::owned_entity(const std::string& id) const {
+  auto entity = topology_.find(id);
+  if (!entity) {
+    return fail(ErrorCode::not_found, "unknown entity '" + id + "' in topology '" + topology_.name() + "'");
+  }
+  if (!timelines_.owns(*entity)) {
+    return fail(ErrorCode::not_found, "entity '" + id + "' belongs to partition '" +
+                                          topology_.partition(*entity) + "', not served by topology agent '" +
+                                          agent_id() + "'");
+  }
+  return *entity;
+}
+
+void TopologyAgent::on_prepare(const msg::ReservePrepareRequest& request,
+                               dds::ReplyHandle<msg::ReservePrepareReply> reply) {
+  std::lock_guard lock(mutex_);
+  std::vector<topology::Reservation> items;
+  std::vector<topology::EntityIndex> touched;
+  for (const auto& wire_item : request.items()) {
+    auto item = from_wire(topology_, wire_item);
+    if (!item) return send_error(reply, item.error());
+    if (item->agent != request.agent() || item->route != request.route()) {
+      return send_error(reply, Error{ErrorCode::invalid_argument,
+                                     "item on '" + wire_item.entity() + "' is of agent '" + item->agent +
+                                         "' route " + std::to_string(item->route) + ", the request of agent '" +
+                                         request.agent() + "' route " + std::to_string(request.route())});
+    }
+    if (auto owned = owned_entity(wire_item.entity()); !owned) return send_error(reply, owned.error());
+    touched.push_back(item->entity);
+    items.push_back(std::move(*item));
+  }
+  std::vector<topology::ExpectedVersion> expected;
+  for (const auto& wire_version : request.expected()) {
+    auto entity = owned_entity(wire_version.entity());
+    if (!entity) return send_error(reply, entity.error());
+    expected.push_back(topology::ExpectedVersion{*entity, wire_version.version()});
+  }
+  auto prepared = timelines_.prepare(items, expected, request.expires_at());
+  if (!prepared) return send_error(reply, prepared.error());
+  prepared_[*prepared] = PreparedRoute{request.agent(), request.route()};
+  if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  msg::ReservePrepareReply out;
+  out.prepare_id(*prepared);
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (auto entity : touched) {
+    msg::EntityVersion version;
+    version.entity(topology_.id(entity));
+    version.version(timelines_.version(entity));
+    out.versions().push_back(std::move(version));
+  }
+  send_reply(reply, std::move(out));
+}
+
+void TopologyAgent::on_commit(const msg::ReserveCommitRequest& request, StatusHandle reply) {
+  std::lock_guard lock(mutex_);
+  auto committed = timelines_.commit(request.prepare_id());
+  if (committed) {
+    prepared_.erase(request.prepare_id());
+    committed = after_change(timelines_.take_grants());
+  }
+  send_status(reply, committed);
+}
+
+void TopologyAgent::on_abort(const msg::ReserveAbortRequest& request, StatusHandle reply) {
+  std::lock_guard lock(mutex_);
+  auto aborted = timelines_.abort(request.prepare_id());
+  if (aborted) {
+    prepared_.erase(request.prepare_id());
+    aborted = after_change(timelines_.take_grants());
+  }
+  send_status(reply, aborted);
+}
+
+void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHandle reply) {
+  std::lock_guard lock(mutex_);
+  auto entity = owned_entity(request.entity());
+  if (!entity) return send_error(reply, entity.error());
+  auto allocation = timelines_.allocate(request.agent(), *entity);
+  if (!allocation) return send_error(reply, allocation.error());
+  if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  if (allocation->granted || !request.wait()) {
+    msg::AllocateReply out;
+    out.granted(allocation->granted);
+    out.queue_position(static_cast<std::uint32_t>(allocation->queue_position));
+    return send_reply(reply, std::move(out));
+  }
+  spdlog::debug("'{}' waits for '{}' at place {}", request.agent(), request.entity(),
+                allocation->queue_position);
+  waiting_replies_.emplace(std::make_pair(request.agent(), *entity), std::move(reply));
+}
+
+void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle reply) {
+  std::lock_guard lock(mutex_);
+  auto entity = owned_entity(request.entity());
+  if (!entity) return send_error(reply, entity.error());
+  auto grants = timelines_.release(request.agent(), *entity);
+  if (!grants) return send_error(reply, grants.error());
+  send_status(reply, after_change(*grants));
+}
+
+void TopologyAgent::on_lock(const msg::LockRequest& request, dds::ReplyHandle<msg::LockReply> reply) {
+  std::lock_guard lock(mutex_);
+  auto entity = owned_entity(request.entity());
+  if (!entity) return send_error(reply, entity.error());
+  auto report = timelines_.lock(*entity, from_wire(request.window()), request.operator_id(), request.reason());
+  if (!report) return send_error(reply, report.error());
+  const std::string lock_id = wire_lock_id(agent_id(), report->id);
+  spdlog::info("lock {} on '{}' by '{}': {} ({} reservations hit)", lock_id, request.entity(),
+               request.operator_id(), request.reason(), report->hit.size());
+  if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  msg::LockReply out;
+  out.lock_id(lock_id);
+  for (const auto& hit : report->hit) {
+    out.hit().push_back(to_wire(topology_, hit));
+    notify_hit(hit, lock_id);
+  }
+  send_reply(reply, std::move(out));
+}
+
+void TopologyAgent::on_unlock(const msg::UnlockRequest& request, StatusHandle reply) {
+  std::lock_guard lock(mutex_);
+  const std::string& id = request.lock_id();
+  const std::string prefix = agent_id() + "/";
+  topology::LockId number = 0;
+  const char* digits = id.data() + std::min(prefix.size(), id.size());
+  const auto parsed = std::from_chars(digits, id.data() + id.size(), number);
+  if (id.rfind(prefix, 0) != 0 || parsed.ec != std::errc{} || parsed.ptr != id.data() + id.size() ||
+      digits == id.data() + id.size()) {
+    return send_error(reply, Error{ErrorCode::not_found, "lock '" + id + "' is not a lock of topology agent '" +
+                                                             agent_id() + "' (its locks are '" + prefix +
+                                                             "<number>')"});
+  }
+  auto unlocked = timelines_.unlock(number);
+  if (!unlocked) {
+    return send_error(reply, Error{ErrorCode::not_found, "unknown lock '" + id + "'"});
+  }
+  spdlog::info("lock {} removed", id);
+  send_status(reply, after_change({}));
+}
+
+void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<msg::DelayReply> reply) {
+  std::lock_guard lock(mutex_);
+  auto entity = owned_entity(request.entity());
+  if (!entity) return send_error(reply, entity.error());
+  if (request.by() <= 0) {
+    return send_error(reply, Error{ErrorCode::invalid_argument,
+                                   "delay of " + std::to_string(request.by()) + " ns: must be positive"});
+  }
+  auto report = timelines_.delay(request.agent(), request.route(), *entity, request.by());
+  if (!report) return send_error(reply, report.error());
+  if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  msg::DelayReply out;
+  for (const auto& shift : report->shifts) {
+    msg::Shift wire_shift;
+    wire_shift.agent(shift.agent);
+    wire_shift.route(shift.route);
+    wire_shift.from_step(shift.from_step);
+    wire_shift.by(shift.by);
+    out.shifts().push_back(wire_shift);
+    msg::ReservationNotice notice;
+    notice.agent(shift.agent);
+    notice.kind(msg::NOTICE_SHIFTED);
+    notice.route(shift.route);
+    notice.entity(request.entity());
+    notice.shift(shift.by);
+    notice.from_step(shift.from_step);
+    notify(std::move(notice));
+  }
+  for (const auto& hit : report->hit_locks) {
+    out.hit_locks().push_back(to_wire(topology_, hit));
+    for (const auto& lock_entry : timelines_.timeline(hit.entity).locks) {
+      if (lock_entry.window.overlaps(hit.window)) notify_hit(hit, wire_lock_id(agent_id(), lock_entry.id));
+    }
+  }
+  send_reply(reply, std::move(out));
+}
+
+void TopologyAgent::on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply) {
+  std::lock_guard lock(mutex_);
+  auto grants = timelines_.cancel_route(request.agent(), request.route());
+  if (!grants) return send_error(reply, grants.error());
+  std::erase_if(prepared_, [&](const auto& entry) {
+    return entry.second.agent == request.agent() && entry.second.route == request.route();
+  });
+  send_status(reply, after_change(*grants));
+}
+
+void TopologyAgent::run_expiry() {
+  std::unique_lock lock(mutex_);
+  while (!expiry_wake_.wait_for(lock, options_.expiry_period, [this] { return stopping_; })) {
+    const auto expired = timelines_.expire(clock_.now());
+    if (expired.empty()) continue;
+    for (auto id : expired) {
+      auto found = prepared_.find(id);
+      if (found == prepared_.end()) continue;
+      spdlog::info("prepared hold {} of '{}' route {} expired", id, found->second.agent, found->second.route);
+      msg::ReservationNotice notice;
+      notice.agent(found->second.agent);
+      notice.kind(msg::NOTICE_PREPARE_EXPIRED);
+      notice.route(found->second.route);
+      notify(std::move(notice));
+      prepared_.erase(found);
+    }
+    if (!after_change(timelines_.take_grants())) return;
+  }
+}
+
+Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants) {
+  std::vector<topology::EntityIndex> changed;
+  for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
+    if (timelines_.owns(entity) && timelines_.timeline(entity).version != published_versions_[entity]) {
+      changed.push_back(entity);
+    }
+  }
+  if (journal_ && !changed.empty()) {
+    if (auto saved = journal_->save(timelines_.snapshot(changed)); !saved) {
+      spdlog::critical("journal not saved, stopping (a restart continues from the journal): {}",
+                       saved.error().message);
+      dds::request_shutdown();
+      return saved;
+    }
+  }
+  for (auto entity : changed) {
+    const auto& timeline = timelines_.timeline(entity);
+    if (auto written = timeline_writer_->write(to_wire_timeline(topology_, agent_id(), entity, timeline));
+        !written) {
+      spdlog::error("timeline of '{}' not published: {}", topology_.id(entity), written.error().message);
+      continue;
+    }
+    published_versions_[entity] = timeline.version;
+  }
+  for (const auto& grant : grants) {
+    msg::ReservationNotice notice;
+    notice.agent(grant.agent);
+    notice.kind(msg::NOTICE_ALLOCATION_GRANTED);
+    notice.entity(topology_.id(grant.entity));
+    notify(std::move(notice));
+  }
+  // Queued requests: answered once their agent holds the entity, or with an error once it
+  // no longer waits (its reservations there were cancelled).
+  for (auto it = waiting_replies_.begin(); it != waiting_replies_.end();) {
+    const auto& [agent, entity] = it->first;
+    const auto& timeline = timelines_.timeline(entity);
+    if (timeline.holder == agent) {
+      msg::AllocateReply out;
+      out.granted(true);
+      send_reply(it->second, std::move(out));
+    } else if (std::find(timeline.waiting.begin(), timeline.waiting.end(), agent) == timeline.waiting.end()) {
+      send_error(it->second, Error{ErrorCode::not_found, "allocation request of '" + agent + "' on '" +
+                                                             topology_.id(entity) +
+                                                             "' withdrawn: its reservations there are gone"});
+    } else {
+      ++it;
+      continue;
+    }
+    it = waiting_replies_.erase(it);
+  }
+  return {};
+}
+
+void TopologyAgent::notify(msg::ReservationNotice notice) {
+  notice.source(agent_id());
+  if (auto written = notice_writer_->write(notice); !written) {
+    spdlog::error("notice to '{}' not sent: {}", notice.agent(), written.error().message);
+  }
+}
+
+void TopologyAgent::notify_hit(const topology::Reservation& hit, const std::string& lock_id) {
+  msg::ReservationNotice notice;
+  notice.agent(hit.agent);
+  notice.kind(msg::NOTICE_LOCK_HIT);
+  notice.route(hit.route);
+  notice.entity(topology_.id(hit.entity));
+  notice.from_step(hit.step);
+  notice.lock_id(lock_id);
+  notice.window(to_wire(hit.window));
+  notify(std::move(notice));
+}
+
+}  // namespace drover::topology_agent

@@ -1,0 +1,151 @@
+#pragma once
+// The topology agent (docs/topology-agent.md): owns the entities of one partition of a
+// topology (or all of them), publishes their static descriptions and timelines, and serves
+// the reservation, allocation, lock, delay and cancel services over DDS. One TimelineSet
+// holds the state; every service handler runs under one mutex, so each request is applied
+// whole before the next one, and every changed timeline is republished before the reply.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "agents/topology_agent/journal.hpp"
+#include "drover/common/clock.hpp"
+#include "drover/common/result.hpp"
+#include "drover/dds/heartbeat_publisher.hpp"
+#include "drover/dds/participant.hpp"
+#include "drover/dds/service_server.hpp"
+#include "drover/dds/writer.hpp"
+#include "drover/topology/model.hpp"
+#include "drover/topology/timeline.hpp"
+#include "topology.h"
+
+namespace drover::topology_agent {
+
+/// Topics and services (area "topology") of the topology agents.
+inline constexpr const char* kEntityTopic = "drover/topology/entity";
+inline constexpr const char* kTimelineTopic = "drover/topology/timeline";
+inline constexpr const char* kNoticeTopic = "drover/topology/notices";
+inline constexpr const char* kServiceArea = "topology";
+
+struct TopologyAgentOptions {
+  /// The partition served; empty: every entity of the topology.
+  std::string partition;
+  /// DDS domain and participant settings; participant.agent_id is the agent's id.
+  dds::ParticipantOptions participant;
+  /// The SQLite journal (docs/topology-agent.md "Persistence"); empty: none, the state
+  /// lives in memory only.
+  std::filesystem::path journal_file;
+  /// How often prepared holds past their expiry are dropped.
+  std::chrono::milliseconds expiry_period{100};
+};
+
+/// Thread-safe; serves from the moment create() returns until it is destroyed.
+class TopologyAgent {
+ public:
+  /// Starts serving `topology` (the part of it options.partition names).
+  /// With a journal file, the timelines are restored from it first.
+  /// \return the agent, or invalid_argument (a partition that owns no entity of the
+  ///         topology, a bad agent id, a journal that breaks the invariants), the
+  ///         journal's errors (io, parse, conflict, unavailable, naming the file) or the
+  ///         DDS layer's errors.
+  static Result<std::unique_ptr<TopologyAgent>> create(topology::Topology topology, SharedClock clock,
+                                                       TopologyAgentOptions options);
+  /// Stops the expiry sweep, answers queued allocation requests with `unavailable` and
+  /// deletes the DDS entities.
+  ~TopologyAgent();
+  TopologyAgent(const TopologyAgent&) = delete;
+  TopologyAgent& operator=(const TopologyAgent&) = delete;
+
+  const std::string& agent_id() const noexcept { return participant_->agent_id(); }
+  /// The partitions this agent serves (what its heartbeat says it owns).
+  std::vector<std::string> served_partitions() const;
+  /// Number of entities it owns.
+  std::size_t owned_count() const noexcept { return owned_count_; }
+
+ private:
+  template <class Req, class Rep>
+  using Server = std::unique_ptr<dds::ServiceServer<Req, Rep>>;
+  using StatusHandle = dds::ReplyHandle<msg::StatusReply>;
+  using AllocateHandle = dds::ReplyHandle<msg::AllocateReply>;
+
+  TopologyAgent(topology::Topology topology, SharedClock clock, TopologyAgentOptions options,
+                std::size_t owned_count, topology::TimelineSet timelines,
+                std::optional<Journal> journal, std::unique_ptr<dds::Participant> participant);
+  Status start();
+
+  /// The owned entity named `id`, or not_found (unknown, or of another partition).
+  Result<topology::EntityIndex> owned_entity(const std::string& id) const;
+
+  void on_prepare(const msg::ReservePrepareRequest& request, dds::ReplyHandle<msg::ReservePrepareReply> reply);
+  void on_commit(const msg::ReserveCommitRequest& request, StatusHandle reply);
+  void on_abort(const msg::ReserveAbortRequest& request, StatusHandle reply);
+  void on_allocate(const msg::AllocateRequest& request, AllocateHandle reply);
+  void on_release(const msg::ReleaseRequest& request, StatusHandle reply);
+  void on_lock(const msg::LockRequest& request, dds::ReplyHandle<msg::LockReply> reply);
+  void on_unlock(const msg::UnlockRequest& request, StatusHandle reply);
+  void on_delay(const msg::DelayRequest& request, dds::ReplyHandle<msg::DelayReply> reply);
+  void on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply);
+  void run_expiry();
+
+  // The members below run with mutex_ held.
+  /// Saves every owned timeline whose version differs from the one last published to the
+  /// journal, then republishes them, answers queued allocation requests that were granted
+  /// or withdrawn, and sends a NOTICE_ALLOCATION_GRANTED for every grant the timelines
+  /// made. \return the journal's error when the save failed: then nothing is published,
+  /// the operation must not be acknowledged, and the agent shuts down (its memory is
+  /// ahead of its journal; a restart continues from the journal).
+  Status after_change(const std::vector<topology::Grant>& grants);
+  void notify(msg::ReservationNotice notice);
+  void notify_hit(const topology::Reservation& hit, const std::string& lock_id);
+
+  const topology::Topology topology_;
+  const SharedClock clock_;
+  const TopologyAgentOptions options_;
+  const std::size_t owned_count_;
+
+  // DDS entities: the participant is declared first so that it is destroyed last.
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Writer<msg::EntityDescription>> description_writer_;
+  std::unique_ptr<dds::Writer<msg::TimelineState>> timeline_writer_;
+  std::unique_ptr<dds::Writer<msg::ReservationNotice>> notice_writer_;
+  std::unique_ptr<dds::HeartbeatPublisher> heartbeat_;
+
+  mutable std::mutex mutex_;
+  topology::TimelineSet timelines_;
+  std::optional<Journal> journal_;
+  std::vector<std::uint64_t> published_versions_;  // per entity; last version published
+  struct PreparedRoute {
+    std::string agent;
+    topology::RouteId route = 0;
+  };
+  std::map<topology::PrepareId, PreparedRoute> prepared_;  // to tell owners of expired holds
+  /// Allocation requests with wait = true that are queued: answered when granted.
+  std::multimap<std::pair<std::string, topology::EntityIndex>, AllocateHandle> waiting_replies_;
+
+  std::condition_variable expiry_wake_;
+  bool stopping_ = false;
+  std::thread expiry_thread_;
+
+  // Servers last: destroyed first, so no handler runs while the rest goes away.
+  Server<msg::ReservePrepareRequest, msg::ReservePrepareReply> prepare_server_;
+  Server<msg::ReserveCommitRequest, msg::StatusReply> commit_server_;
+  Server<msg::ReserveAbortRequest, msg::StatusReply> abort_server_;
+  Server<msg::AllocateRequest, msg::AllocateReply> allocate_server_;
+  Server<msg::ReleaseRequest, msg::StatusReply> release_server_;
+  Server<msg::LockRequest, msg::LockReply> lock_server_;
+  Server<msg::UnlockRequest, msg::StatusReply> unlock_server_;
+  Server<msg::DelayRequest, msg::DelayReply> delay_server_;
+  Server<msg::CancelRouteRequest, msg::StatusReply> cancel_server_;
+};
+
+}  // namespace drover::topology_agent

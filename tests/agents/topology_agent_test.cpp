@@ -1,0 +1,556 @@
+// The topology agent as a process (`drover topology-agent`): the test process is its
+// client over DDS. Domains 210..218. Every agent is stopped with SIGTERM and must exit 0.
+
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "agents/topology_agent/topology_agent.hpp"
+#include "agents/topology_agent/wire.hpp"
+#include "drover/dds/reader.hpp"
+#include "drover/dds/service_client.hpp"
+#include "drover/topology/topology_file.hpp"
+#include "tests/agents/dds_test_support.hpp"
+
+namespace drover::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A line a - b - c - d; a, b and their edges are partition west, c, d and c-d east. Edge
+// footprints overlap their end vertices, so a reservation on a vertex shadows its edges.
+constexpr const char* kLineTopology = R"({
+  "name": "line",
+  "vertices": [
+    {"id": "a", "x": 0, "y": 0, "partition": "west"},
+    {"id": "b", "x": 3, "y": 0, "partition": "west"},
+    {"id": "c", "x": 6, "y": 0, "partition": "east"},
+    {"id": "d", "x": 9, "y": 0, "partition": "east"}
+  ],
+  "edges": [
+    {"id": "a-b", "from": "a", "to": "b", "bidirectional": true, "max_speed": 1.0, "partition": "west"},
+    {"id": "b-c", "from": "b", "to": "c", "bidirectional": true, "max_speed": 1.0, "partition": "west"},
+    {"id": "c-d", "from": "c", "to": "d", "bidirectional": true, "max_speed": 1.0, "partition": "east"}
+  ]
+})";
+
+std::string write_topology_file() {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("drover-topology-agent-test-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(path) << kLineTopology;
+  return path.string();
+}
+
+template <class Req, class Rep>
+using Client = std::unique_ptr<dds::ServiceClient<Req, Rep>>;
+
+template <class Req, class Rep>
+Client<Req, Rep> make_client(dds::Participant& participant, const char* service) {
+  auto client = dds::ServiceClient<Req, Rep>::create(participant, "topology", service);
+  EXPECT_TRUE(client.has_value()) << (client ? "" : client.error().message);
+  return client ? std::move(*client) : nullptr;
+}
+
+/// The test's side: a participant with a client of every service and readers of the
+/// timelines, descriptions and notices the agents publish.
+class TopologyAgentTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    topology_file_ = write_topology_file();
+    auto loaded = topology::load_topology_file(topology_file_);
+    ASSERT_TRUE(loaded.has_value());
+    topology_.emplace(std::move(*loaded));
+  }
+
+  void TearDown() override {
+    for (auto& agent : agents_) {
+      agent.signal(SIGTERM);
+      auto status = agent.wait_exit(kDiscoveryTimeout);
+      ASSERT_TRUE(status.has_value()) << "the agent did not stop on SIGTERM";
+      EXPECT_TRUE(status->exited) << "killed by signal " << status->code;
+      EXPECT_EQ(status->code, 0);
+    }
+    readers_.clear();
+    prepare_.reset();
+    commit_.reset();
+    abort_.reset();
+    allocate_.reset();
+    release_.reset();
+    lock_.reset();
+    unlock_.reset();
+    delay_.reset();
+    cancel_.reset();
+    participant_.reset();
+    agents_.clear();
+    std::filesystem::remove(topology_file_);
+  }
+
+  void start_agent(std::uint32_t domain, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args{"topology-agent", "--topology", topology_file_, "--domain",
+                                  std::to_string(domain)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    auto agent = ChildProcess::spawn(binary_path("drover"), args);
+    ASSERT_TRUE(agent.has_value());
+    agents_.push_back(std::move(*agent));
+  }
+
+  void connect(std::uint32_t domain) {
+    participant_ = make_participant(domain, "tester");
+    ASSERT_NE(participant_, nullptr);
+    prepare_ = make_client<msg::ReservePrepareRequest, msg::ReservePrepareReply>(*participant_, "reserve_prepare");
+    commit_ = make_client<msg::ReserveCommitRequest, msg::StatusReply>(*participant_, "reserve_commit");
+    abort_ = make_client<msg::ReserveAbortRequest, msg::StatusReply>(*participant_, "reserve_abort");
+    allocate_ = make_client<msg::AllocateRequest, msg::AllocateReply>(*participant_, "allocate");
+    release_ = make_client<msg::ReleaseRequest, msg::StatusReply>(*participant_, "release");
+    lock_ = make_client<msg::LockRequest, msg::LockReply>(*participant_, "lock");
+    unlock_ = make_client<msg::UnlockRequest, msg::StatusReply>(*participant_, "unlock");
+    delay_ = make_client<msg::DelayRequest, msg::DelayReply>(*participant_, "delay");
+    cancel_ = make_client<msg::CancelRouteRequest, msg::StatusReply>(*participant_, "cancel_route");
+    auto timelines = dds::Reader<msg::TimelineState>::create(
+        *participant_, topology_agent::kTimelineTopic, [this](const msg::TimelineState& state) {
+          std::lock_guard lock(mutex_);
+          timelines_[state.entity()] = state;
+          changed_.notify_all();
+        });
+    ASSERT_TRUE(timelines.has_value());
+    auto descriptions = dds::Reader<msg::EntityDescription>::create(
+        *participant_, topology_agent::kEntityTopic, [this](const msg::EntityDescription& description) {
+          std::lock_guard lock(mutex_);
+          descriptions_[description.id()] = description;
+          changed_.notify_all();
+        });
+    ASSERT_TRUE(descriptions.has_value());
+    auto notices = dds::Reader<msg::ReservationNotice>::create(
+        *participant_, topology_agent::kNoticeTopic,
+        [this](const msg::ReservationNotice& notice) {
+          std::lock_guard lock(mutex_);
+          notices_.push_back(notice);
+          changed_.notify_all();
+        },
+        dds::ReaderOptions{dds::TopicQos::events(), {}, {}});
+    ASSERT_TRUE(notices.has_value());
+    readers_.push_back(std::shared_ptr<void>(std::move(*timelines)));
+    readers_.push_back(std::shared_ptr<void>(std::move(*descriptions)));
+    readers_.push_back(std::shared_ptr<void>(std::move(*notices)));
+  }
+
+  /// Waits until `condition` (called with the mutex held) holds. \return whether it did.
+  template <class Condition>
+  bool wait_until(Condition condition) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, kDiscoveryTimeout, [&] { return condition(); });
+  }
+
+  /// The last published timeline of `entity` (waits for one).
+  msg::TimelineState timeline(const std::string& entity) {
+    EXPECT_TRUE(wait_until([&] { return timelines_.count(entity) > 0; })) << "no timeline of " << entity;
+    std::lock_guard lock(mutex_);
+    return timelines_[entity];
+  }
+
+  /// Waits until the timeline of `entity` reaches `version` at least.
+  msg::TimelineState timeline_at(const std::string& entity, std::uint64_t version) {
+    EXPECT_TRUE(wait_until([&] { return timelines_.count(entity) > 0 && timelines_[entity].version() >= version; }))
+        << "timeline of " << entity << " never reached version " << version;
+    std::lock_guard lock(mutex_);
+    return timelines_[entity];
+  }
+
+  /// The wire items a route of `agent` writes (real and shadow) on the entities of
+  /// `partition` (empty: all), as a routing agent splits them by owner.
+  std::vector<msg::Reservation> items(const std::string& agent, topology::RouteId route,
+                                      const std::vector<std::pair<std::string, topology::Interval>>& steps,
+                                      const std::string& partition = {}) {
+    std::vector<topology::RouteStep> route_steps;
+    for (const auto& [id, window] : steps) route_steps.push_back({*topology_->find(id), window});
+    const topology::TimelineSet expander(topology_->conflict_sets());
+    std::vector<msg::Reservation> out;
+    for (const auto& item : expander.expand(agent, route, route_steps)) {
+      if (partition.empty() || topology_->partition(item.entity) == partition) {
+        out.push_back(topology_agent::to_wire(*topology_, item));
+      }
+    }
+    return out;
+  }
+
+  msg::ReservePrepareRequest prepare_request(const std::string& agent, topology::RouteId route,
+                                             std::vector<msg::Reservation> route_items,
+                                             std::vector<std::pair<std::string, std::uint64_t>> expected = {},
+                                             TimeNs expires_at = SharedClock::wall().now() + seconds_to_ns(600)) {
+    msg::ReservePrepareRequest request;
+    request.agent(agent);
+    request.route(route);
+    request.items(std::move(route_items));
+    for (const auto& [entity, version] : expected) {
+      msg::EntityVersion entry;
+      entry.entity(entity);
+      entry.version(version);
+      request.expected().push_back(entry);
+    }
+    request.expires_at(expires_at);
+    return request;
+  }
+
+  /// Prepares and commits a route; fails the test when either is refused.
+  void reserve(const std::string& agent, topology::RouteId route,
+               const std::vector<std::pair<std::string, topology::Interval>>& steps,
+               const std::string& responder = {}, const std::string& partition = {}) {
+    auto prepared = prepare_->call(prepare_request(agent, route, items(agent, route, steps, partition)),
+                                   kDiscoveryTimeout, responder);
+    ASSERT_TRUE(prepared.has_value()) << prepared.error().message;
+    ASSERT_EQ(prepared->error().code(), msg::ERROR_NONE) << prepared->error().message();
+    msg::ReserveCommitRequest commit;
+    commit.prepare_id(prepared->prepare_id());
+    auto committed = commit_->call(commit, kDiscoveryTimeout, responder);
+    ASSERT_TRUE(committed.has_value()) << committed.error().message;
+    ASSERT_EQ(committed->error().code(), msg::ERROR_NONE) << committed->error().message();
+  }
+
+  msg::AllocateReply allocate(const std::string& agent, const std::string& entity, bool wait) {
+    msg::AllocateRequest request;
+    request.agent(agent);
+    request.entity(entity);
+    request.wait(wait);
+    auto reply = allocate_->call(request, kDiscoveryTimeout);
+    EXPECT_TRUE(reply.has_value()) << reply.error().message;
+    return reply ? *reply : msg::AllocateReply{};
+  }
+
+  msg::LockReply lock(const std::string& entity, TimeNs start, TimeNs end, const std::string& responder = {}) {
+    msg::LockRequest request;
+    request.entity(entity);
+    request.window().start(start);
+    request.window().end(end);
+    request.operator_id("operator-1");
+    request.reason("spilled oil");
+    auto reply = lock_->call(request, kDiscoveryTimeout, responder);
+    EXPECT_TRUE(reply.has_value()) << reply.error().message;
+    return reply ? *reply : msg::LockReply{};
+  }
+
+  msg::StatusReply unlock(const std::string& lock_id) {
+    msg::UnlockRequest request;
+    request.lock_id(lock_id);
+    auto reply = unlock_->call(request, kDiscoveryTimeout);
+    EXPECT_TRUE(reply.has_value()) << reply.error().message;
+    return reply ? *reply : msg::StatusReply{};
+  }
+
+  msg::StatusReply release(const std::string& agent, const std::string& entity) {
+    msg::ReleaseRequest request;
+    request.agent(agent);
+    request.entity(entity);
+    auto reply = release_->call(request, kDiscoveryTimeout);
+    EXPECT_TRUE(reply.has_value()) << reply.error().message;
+    return reply ? *reply : msg::StatusReply{};
+  }
+
+  std::string topology_file_;
+  std::optional<topology::Topology> topology_;
+  std::vector<ChildProcess> agents_;
+  std::unique_ptr<dds::Participant> participant_;
+  Client<msg::ReservePrepareRequest, msg::ReservePrepareReply> prepare_;
+  Client<msg::ReserveCommitRequest, msg::StatusReply> commit_;
+  Client<msg::ReserveAbortRequest, msg::StatusReply> abort_;
+  Client<msg::AllocateRequest, msg::AllocateReply> allocate_;
+  Client<msg::ReleaseRequest, msg::StatusReply> release_;
+  Client<msg::LockRequest, msg::LockReply> lock_;
+  Client<msg::UnlockRequest, msg::StatusReply> unlock_;
+  Client<msg::DelayRequest, msg::DelayReply> delay_;
+  Client<msg::CancelRouteRequest, msg::StatusReply> cancel_;
+  std::vector<std::shared_ptr<void>> readers_;
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<std::string, msg::TimelineState> timelines_;
+  std::map<std::string, msg::EntityDescription> descriptions_;
+  std::vector<msg::ReservationNotice> notices_;
+};
+
+TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingPrepareChangesNothing) {
+  start_agent(210);
+  connect(210);
+  ASSERT_EQ(timeline("a").version(), 0u);
+
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  const auto after_commit = timeline_at("a", 2);  // prepare and commit each change it
+  ASSERT_EQ(after_commit.reservations().size(), 1u);
+  EXPECT_EQ(after_commit.reservations()[0].agent(), "v1");
+  EXPECT_EQ(after_commit.reservations()[0].window().start(), 1000);
+  EXPECT_FALSE(after_commit.reservations()[0].prepared());
+
+  // Another agent overlapping v1: conflict. A plan made on an old version: conflict.
+  auto rejected = prepare_->call(prepare_request("v2", 7, items("v2", 7, {{"a", {1500, 2500}}})), kDiscoveryTimeout);
+  ASSERT_TRUE(rejected.has_value());
+  EXPECT_EQ(rejected->error().code(), msg::ERROR_CONFLICT) << rejected->error().message();
+
+  // A later change on d is published after anything the rejected calls could have sent.
+  reserve("v3", 1, {{"d", {0, 10}}});
+  timeline_at("d", 2);
+  EXPECT_EQ(timeline("a").version(), after_commit.version());
+  EXPECT_EQ(timeline("a").reservations().size(), 1u);
+}
+
+TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequesterIsAnsweredOnRelease) {
+  start_agent(211);
+  connect(211);
+  reserve("v1", 1, {{"b", {1000, 2000}}});
+  reserve("v2", 1, {{"b", {3000, 4000}}});
+
+  const auto early = allocate("v2", "b", false);
+  EXPECT_EQ(early.error().code(), msg::ERROR_NONE) << early.error().message();
+  EXPECT_FALSE(early.granted());
+  EXPECT_EQ(early.queue_position(), 1u);
+
+  const auto first = allocate("v1", "b", false);
+  EXPECT_EQ(first.error().code(), msg::ERROR_NONE) << first.error().message();
+  EXPECT_TRUE(first.granted());
+
+  auto waiting = std::async(std::launch::async, [this] { return allocate("v2", "b", true); });
+  EXPECT_TRUE(wait_until([&] {
+    const auto& state = timelines_["b"];
+    return state.holder() == "v1" && state.waiting() == std::vector<std::string>{"v2"};
+  })) << "the timeline shows v1 holding b and v2 in the queue";
+  EXPECT_EQ(waiting.wait_for(0s), std::future_status::timeout) << "v2 must not be granted before v1 releases";
+
+  EXPECT_EQ(release("v1", "b").error().code(), msg::ERROR_NONE);
+  const auto granted = waiting.get();
+  EXPECT_EQ(granted.error().code(), msg::ERROR_NONE) << granted.error().message();
+  EXPECT_TRUE(granted.granted());
+  EXPECT_TRUE(wait_until([&] { return timelines_["b"].holder() == "v2" && timelines_["b"].waiting().empty(); }));
+  EXPECT_TRUE(wait_until([&] {
+    for (const auto& notice : notices_) {
+      if (notice.agent() == "v2" && notice.kind() == msg::NOTICE_ALLOCATION_GRANTED && notice.entity() == "b") return true;
+    }
+    return false;
+  }));
+}
+
+TEST_F(TopologyAgentTest, ALockNotifiesTheOwnersOfHitReservationsAndUnlockRemovesIt) {
+  start_agent(212);
+  connect(212);
+  reserve("v1", 4, {{"c", {100, 200}}});
+  const auto locked = lock("c", 150, 300);
+  ASSERT_EQ(locked.error().code(), msg::ERROR_NONE) << locked.error().message();
+  EXPECT_EQ(locked.lock_id(), "topology/1");
+  ASSERT_EQ(locked.hit().size(), 1u);
+  EXPECT_EQ(locked.hit()[0].agent(), "v1");
+  EXPECT_TRUE(wait_until([&] {
+    for (const auto& notice : notices_) {
+      if (notice.agent() == "v1" && notice.kind() == msg::NOTICE_LOCK_HIT && notice.lock_id() == "topology/1" &&
+          notice.route() == 4) {
+        return true;
+      }
+    }
+    return false;
+  }));
+  EXPECT_TRUE(wait_until([&] {
+    const auto& locks = timelines_["c"].locks();
+    return locks.size() == 1 && locks[0].id() == "topology/1" && locks[0].operator_id() == "operator-1" &&
+           locks[0].reason() == "spilled oil" && locks[0].window().end() == 300;
+  }));
+  // A new reservation into the lock is refused.
+  auto blocked = prepare_->call(prepare_request("v2", 1, items("v2", 1, {{"c", {250, 260}}})), kDiscoveryTimeout);
+  ASSERT_TRUE(blocked.has_value());
+  EXPECT_EQ(blocked->error().code(), msg::ERROR_CONFLICT);
+
+  EXPECT_EQ(unlock("topology/1").error().code(), msg::ERROR_NONE);
+  EXPECT_TRUE(wait_until([&] { return timelines_["c"].locks().empty(); }));
+  reserve("v2", 1, {{"c", {250, 260}}});
+}
+
+TEST_F(TopologyAgentTest, BadRequestsGetAnErrorReplyAndChangeNothing) {
+  start_agent(213);
+  connect(213);
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  const auto before = timeline_at("a", 2);
+
+  const auto unknown = allocate("v1", "nowhere", false);
+  EXPECT_EQ(unknown.error().code(), msg::ERROR_NOT_FOUND);
+  EXPECT_NE(unknown.error().message().find("nowhere"), std::string::npos) << unknown.error().message();
+
+  const auto malformed = lock("a", 500, 500);
+  EXPECT_EQ(malformed.error().code(), msg::ERROR_INVALID_ARGUMENT) << malformed.error().message();
+
+  const auto not_held = release("v1", "a");
+  EXPECT_EQ(not_held.error().code(), msg::ERROR_NOT_PERMITTED) << not_held.error().message();
+
+  EXPECT_EQ(unlock("topology/99").error().code(), msg::ERROR_NOT_FOUND);
+  EXPECT_EQ(unlock("garbage").error().code(), msg::ERROR_NOT_FOUND);
+  EXPECT_EQ(unlock("topology/").error().code(), msg::ERROR_NOT_FOUND);
+
+  msg::DelayRequest backwards;
+  backwards.agent("v1");
+  backwards.route(1);
+  backwards.entity("a");
+  backwards.by(-5);
+  auto delayed = delay_->call(backwards, kDiscoveryTimeout);
+  ASSERT_TRUE(delayed.has_value());
+  EXPECT_EQ(delayed->error().code(), msg::ERROR_INVALID_ARGUMENT);
+
+  msg::CancelRouteRequest no_route;
+  no_route.agent("v9");
+  no_route.route(3);
+  auto cancelled = cancel_->call(no_route, kDiscoveryTimeout);
+  ASSERT_TRUE(cancelled.has_value());
+  EXPECT_EQ(cancelled->error().code(), msg::ERROR_NOT_FOUND);
+
+  auto no_items = prepare_->call(prepare_request("v1", 2, {}), kDiscoveryTimeout);
+  ASSERT_TRUE(no_items.has_value());
+  EXPECT_EQ(no_items->error().code(), msg::ERROR_INVALID_ARGUMENT);
+
+  reserve("v3", 1, {{"d", {0, 10}}});
+  timeline_at("d", 2);
+  EXPECT_EQ(timeline("a"), before);
+}
+
+TEST_F(TopologyAgentTest, DelayShiftsThePushedRouteAndNotifiesEveryAffectedAgent) {
+  start_agent(214);
+  connect(214);
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  reserve("v2", 1, {{"a", {2000, 3000}}});
+  msg::DelayRequest request;
+  request.agent("v1");
+  request.route(1);
+  request.entity("a");
+  request.by(500);
+  auto delayed = delay_->call(request, kDiscoveryTimeout);
+  ASSERT_TRUE(delayed.has_value());
+  ASSERT_EQ(delayed->error().code(), msg::ERROR_NONE) << delayed->error().message();
+  ASSERT_EQ(delayed->shifts().size(), 2u);
+  EXPECT_EQ(delayed->shifts()[0].agent(), "v1");
+  EXPECT_EQ(delayed->shifts()[1].agent(), "v2");
+  EXPECT_TRUE(wait_until([&] {
+    bool v1 = false, v2 = false;
+    for (const auto& notice : notices_) {
+      if (notice.kind() != msg::NOTICE_SHIFTED) continue;
+      v1 = v1 || notice.agent() == "v1";
+      v2 = v2 || (notice.agent() == "v2" && notice.shift() == 500);
+    }
+    return v1 && v2;
+  }));
+  EXPECT_TRUE(wait_until([&] {
+    const auto& reservations = timelines_["a"].reservations();
+    return reservations.size() == 2 && reservations[1].agent() == "v2" && reservations[1].window().start() == 2500;
+  }));
+}
+
+TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
+  start_agent(215, {"--partition", "west"});
+  start_agent(215, {"--partition", "east"});
+  connect(215);
+  EXPECT_TRUE(wait_until([&] { return descriptions_.size() == topology_->entity_count(); }));
+  {
+    std::lock_guard guard(mutex_);
+    EXPECT_EQ(descriptions_["a"].partition(), "west");
+    EXPECT_EQ(descriptions_["c-d"].partition(), "east");
+    EXPECT_EQ(descriptions_["c-d"].kind(), msg::ENTITY_EDGE);
+    EXPECT_EQ(descriptions_["c-d"].from(), "c");
+  }
+  // Each agent takes only its own entities.
+  const auto wrong = lock("c", 0, 100, "topology-west");
+  EXPECT_EQ(wrong.error().code(), msg::ERROR_NOT_FOUND);
+  EXPECT_NE(wrong.error().message().find("east"), std::string::npos) << wrong.error().message();
+  const auto right = lock("c", 0, 100, "topology-east");
+  EXPECT_EQ(right.error().code(), msg::ERROR_NONE) << right.error().message();
+  EXPECT_EQ(right.lock_id(), "topology-east/1");
+
+  // A route over b-c then c: the part on each partition goes to its owner.
+  const std::vector<std::pair<std::string, topology::Interval>> route{{"b-c", {200, 210}}, {"c", {210, 400}}};
+  reserve("v1", 1, route, "topology-west", "west");
+  reserve("v1", 1, route, "topology-east", "east");
+  EXPECT_TRUE(wait_until([&] { return !timelines_["b-c"].reservations().empty(); }));
+  EXPECT_TRUE(wait_until([&] { return !timelines_["c"].reservations().empty(); }));
+}
+
+TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
+  start_agent(216);
+  connect(216);
+  auto prepared = prepare_->call(
+      prepare_request("v1", 1, items("v1", 1, {{"b", {1000, 2000}}}), {}, SharedClock::wall().now() + seconds_to_ns(1)),
+      kDiscoveryTimeout);
+  ASSERT_TRUE(prepared.has_value());
+  ASSERT_EQ(prepared->error().code(), msg::ERROR_NONE) << prepared->error().message();
+  EXPECT_TRUE(wait_until([&] {
+    for (const auto& notice : notices_) {
+      if (notice.agent() == "v1" && notice.kind() == msg::NOTICE_PREPARE_EXPIRED && notice.route() == 1) return true;
+    }
+    return false;
+  }));
+  EXPECT_TRUE(wait_until([&] { return timelines_["b"].version() >= 2 && timelines_["b"].reservations().empty(); }));
+  msg::ReserveCommitRequest late;
+  late.prepare_id(prepared->prepare_id());
+  auto committed = commit_->call(late, kDiscoveryTimeout);
+  ASSERT_TRUE(committed.has_value());
+  EXPECT_EQ(committed->error().code(), msg::ERROR_NOT_FOUND);
+  reserve("v2", 1, {{"b", {1000, 2000}}});
+}
+
+TEST_F(TopologyAgentTest, AfterKill9TheRestartedAgentHasItsCommittedStateBack) {
+  const auto journal = std::filesystem::path(topology_file_).replace_extension(".db");
+  std::filesystem::remove(journal);
+  start_agent(217, {"--db", journal.string()});
+  connect(217);
+  std::atomic<bool> gone{false};
+  const auto token = participant_->subscribe_events([&](const dds::ParticipantEvent& event) {
+    if (event.name == "topology" && event.change != dds::ParticipantChange::discovered) gone = true;
+  });
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  reserve("v2", 1, {{"a", {3000, 4000}}});
+  EXPECT_TRUE(allocate("v1", "a", false).granted());
+  EXPECT_EQ(lock("c", 0, 500).lock_id(), "topology/1");
+  ASSERT_TRUE(wait_until([&] { return timelines_["a"].holder() == "v1"; }));
+  const auto before = timeline("a");
+
+  agents_.back().signal(SIGKILL);
+  ASSERT_TRUE(agents_.back().wait_exit(kDiscoveryTimeout).has_value());
+  agents_.pop_back();
+  EXPECT_TRUE(wait_until([&] { return gone.load(); })) << "the killed agent is seen gone";
+  participant_->unsubscribe_events(token);
+  {
+    std::lock_guard guard(mutex_);
+    timelines_.clear();
+  }
+  start_agent(217, {"--db", journal.string()});
+  EXPECT_TRUE(wait_until([&] { return timelines_.count("a") > 0 && timelines_.count("c") > 0; }));
+  {
+    std::lock_guard guard(mutex_);
+    EXPECT_EQ(timelines_["a"].reservations(), before.reservations());
+    EXPECT_EQ(timelines_["a"].holder(), "v1");
+    ASSERT_EQ(timelines_["c"].locks().size(), 1u);
+    EXPECT_EQ(timelines_["c"].locks()[0].id(), "topology/1");
+  }
+  // Ids go on where they stopped; the restored holder releases and the next is granted.
+  EXPECT_EQ(lock("d", 0, 500).lock_id(), "topology/2");
+  EXPECT_EQ(release("v1", "a").error().code(), msg::ERROR_NONE);
+  EXPECT_TRUE(allocate("v2", "a", false).granted());
+  std::filesystem::remove(journal);
+  std::filesystem::remove(journal.string() + "-wal");
+  std::filesystem::remove(journal.string() + "-shm");
+}
+
+TEST(TopologyAgentCommand, APartitionThatOwnsNothingIsBadInput) {
+  const auto file = write_topology_file();
+  auto agent = ChildProcess::spawn(binary_path("drover"),
+                                   {"topology-agent", "--topology", file, "--partition", "north", "--domain", "218"});
+  ASSERT_TRUE(agent.has_value());
+  auto status = agent->wait_exit(kDiscoveryTimeout);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_TRUE(status->exited);
+  EXPECT_EQ(status->code, 2);
+  std::filesystem::remove(file);
+}
+
+}  // namespace
+}  // namespace drover::test
