@@ -4,6 +4,7 @@
 
 #include <signal.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -239,6 +240,17 @@ TEST_F(RanSimDds, PauseCancelAndFaults) {
 
 TEST_F(RanSimDds, CommandsForAnotherVehicleAreRefused) {
   ASSERT_NO_FATAL_FAILURE(start(kDomainOther));
+  // A second client of V1, told of every status by callback.
+  std::atomic<int> callbacks{0};
+  auto watcher = RanClient::create(*participant, "V1", {}, 1,
+                                   [&](const VehicleStatus& status) {
+                                     if (status.vehicle_id == "V1") ++callbacks;
+                                   });
+  ASSERT_TRUE(watcher);
+  ASSERT_TRUE((*watcher)->wait_for([](const VehicleStatus&) { return true; }, kTimeout));
+  EXPECT_GE(callbacks.load(), 1);
+  EXPECT_EQ((*watcher)->history().size(), 1u);  // the history limit
+
   auto other = RanClient::create(*participant, "V2", ran_agent_id("V1"));
   ASSERT_TRUE(other);
   const auto verdict = (*other)->action({"x", ActionKind::load, "", {}}, kCallTimeout);

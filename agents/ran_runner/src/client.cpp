@@ -27,10 +27,12 @@ msg::SimFaultKind fault_to_wire(SimFault fault) {
 
 }  // namespace
 
-RanClient::RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit)
+RanClient::RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit,
+                     StatusCallback on_status)
     : vehicle_id_(std::move(vehicle_id)),
       ran_agent_(std::move(ran_agent)),
-      history_limit_(std::max<std::size_t>(history_limit, 1)) {}
+      history_limit_(std::max<std::size_t>(history_limit, 1)),
+      on_status_(std::move(on_status)) {}
 
 RanClient::~RanClient() {
   reader_.reset();  // no callback runs after this
@@ -39,11 +41,12 @@ RanClient::~RanClient() {
 Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participant,
                                                      std::string vehicle_id,
                                                      std::string ran_agent,
-                                                     std::size_t history_limit) {
+                                                     std::size_t history_limit,
+                                                     StatusCallback on_status) {
   if (ran_agent.empty()) ran_agent = ran_agent_id(vehicle_id);
   register_ran_type_objects();
-  std::unique_ptr<RanClient> client(
-      new RanClient(std::move(vehicle_id), std::move(ran_agent), history_limit));
+  std::unique_ptr<RanClient> client(new RanClient(std::move(vehicle_id), std::move(ran_agent),
+                                                  history_limit, std::move(on_status)));
   auto commands = CommandClient::create(participant, kServiceArea, kCommandService);
   if (!commands) return unexpected(commands.error());
   client->commands_ = std::move(*commands);
@@ -72,10 +75,11 @@ void RanClient::receive(const msg::RanStatus& wire) {
     // KEEP_LAST 1 and a late join may skip reports, never reorder them; a repeated sample
     // (a replaced RAN starting over at 1) starts a new history.
     if (!history_.empty() && status->sequence <= history_.back().sequence) history_.clear();
-    history_.push_back(std::move(*status));
+    history_.push_back(*status);
     ++received_;
     while (history_.size() > history_limit_) history_.pop_front();
   }
+  if (on_status_) on_status_(*status);
   arrived_.notify_all();
 }
 

@@ -48,13 +48,18 @@ enum class SimFault {
 /// Thread-safe. Must be destroyed before its Participant.
 class RanClient {
  public:
+  /// Called with every status received, on the client's reader thread, after it is
+  /// recorded and before wait_for() sees it; it must not destroy the client.
+  using StatusCallback = std::function<void(const VehicleStatus&)>;
+
   /// A client for `vehicle_id`'s RAN, whose agent id is `ran_agent` (empty: ran_agent_id()),
   /// keeping the last `history_limit` (>= 1) statuses received.
   /// \return the client, or the DDS layer's errors.
   static Result<std::unique_ptr<RanClient>> create(dds::Participant& participant,
                                                    std::string vehicle_id,
                                                    std::string ran_agent = {},
-                                                   std::size_t history_limit = 1000);
+                                                   std::size_t history_limit = 1000,
+                                                   StatusCallback on_status = {});
   ~RanClient();
 
   /// Sends a command and waits for the RAN's reply.
@@ -85,7 +90,8 @@ class RanClient {
   using CommandClient = dds::ServiceClient<msg::RanCommandRequest, msg::RanCommandReply>;
   using FaultClient = dds::ServiceClient<msg::SimFaultRequest, msg::SimFaultReply>;
 
-  RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit);
+  RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit,
+            StatusCallback on_status);
   Result<CommandVerdict> send(msg::RanCommandRequest request, std::chrono::milliseconds timeout);
   void receive(const msg::RanStatus& status);
 
@@ -97,6 +103,7 @@ class RanClient {
   mutable std::mutex mutex_;
   mutable std::condition_variable arrived_;
   std::size_t history_limit_;
+  StatusCallback on_status_;
   std::deque<VehicleStatus> history_;
   std::uint64_t received_ = 0;  ///< statuses received so far; history_.back() is number received_
   std::unique_ptr<dds::Reader<msg::RanStatus>> reader_;  // last: stopped first
