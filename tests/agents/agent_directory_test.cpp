@@ -1,6 +1,8 @@
 // Heartbeats and the agent directory over real processes, and clean shutdown on signals.
 
 #include <chrono>
+#include <iostream>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -72,15 +74,36 @@ TEST_F(AgentDirectoryTest, SeesAHeartbeatAndNoticesWhenItsAgentIsKilled) {
   EXPECT_FALSE(changes.back().alive);
 }
 
+TEST_F(AgentDirectoryTest, NoticesADroppedParticipantWithoutTheDeadline) {
+  constexpr std::uint32_t kDomain = 111;
+  auto peer = spawn_peer(kDomain, "logical-9", {"--heartbeat", "logical"});
+  ASSERT_TRUE(peer.has_value());
+  peers_.push_back(std::move(*peer));
+  auto participant = make_participant(kDomain, "observer");
+  ASSERT_NE(participant, nullptr);
+  // A deadline far beyond the wait below: only the participant's lease (3 s) can tell.
+  dds::AgentDirectoryOptions options;
+  options.deadline = std::chrono::milliseconds(120000);
+  auto directory = dds::AgentDirectory::create(*participant, options);
+  ASSERT_TRUE(directory.has_value()) << directory.error().message;
+  ASSERT_TRUE((*directory)->wait_for_agent("logical-9", true, kDiscoveryTimeout));
+
+  peers_.front().signal(SIGKILL);
+  ASSERT_TRUE((*directory)->wait_for_agent("logical-9", false, kDeathBound));
+  EXPECT_EQ((*directory)->find("logical-9")->lost_reason, "participant dropped");
+}
+
 /// A peer asked to stop by `signal_number` deletes its entities and exits 0; the
-/// directory sees it leave.
+/// directory sees its participant leave (removed, not dropped: it said goodbye).
 void expect_clean_exit_on(int signal_number, std::uint32_t domain, std::vector<ChildProcess>& peers) {
   auto peer = spawn_peer(domain, "stoppable", {"--echo", "--heartbeat", "topology"});
   ASSERT_TRUE(peer.has_value());
   peers.push_back(std::move(*peer));
   auto participant = make_participant(domain, "observer");
   ASSERT_NE(participant, nullptr);
-  auto directory = dds::AgentDirectory::create(*participant);
+  dds::AgentDirectoryOptions options;
+  options.deadline = std::chrono::milliseconds(120000);  // only the removal can tell
+  auto directory = dds::AgentDirectory::create(*participant, options);
   ASSERT_TRUE(directory.has_value()) << directory.error().message;
   // Fully up (handlers installed, entities created) once its heartbeat arrives.
   ASSERT_TRUE((*directory)->wait_for_agent("stoppable", true, kDiscoveryTimeout));
@@ -91,6 +114,7 @@ void expect_clean_exit_on(int signal_number, std::uint32_t domain, std::vector<C
   EXPECT_TRUE(status->exited) << "killed by signal " << status->code;
   EXPECT_EQ(status->code, 0);
   ASSERT_TRUE((*directory)->wait_for_agent("stoppable", false, kDeathBound));
+  EXPECT_EQ((*directory)->find("stoppable")->lost_reason, "participant removed");
 }
 
 TEST_F(AgentDirectoryTest, SigtermStopsAnAgentCleanlyWithExitCodeZero) {

@@ -2,21 +2,13 @@
 
 #include <mutex>
 
-#include "commonTypeObject.h"
-#include "diagnosticsTypeObject.h"
-#include "heartbeatTypeObject.h"
-#include "topologyTypeObject.h"
+#include "register_type_objects.h"
 
 namespace drover::dds {
 
 void register_type_objects() {
   static std::once_flag once;
-  std::call_once(once, [] {
-    registercommonTypes();
-    registerdiagnosticsTypes();
-    registerheartbeatTypes();
-    registertopologyTypes();
-  });
+  std::call_once(once, [] { msg::register_all_type_objects(); });
 }
 
 }  // namespace drover::dds

@@ -139,7 +139,11 @@ Result<std::unique_ptr<Participant>> Participant::create(const ParticipantOption
     self->names_[self->participant_->guid().guidPrefix] = options.agent_id;
   }
   self->publisher_ = self->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-  self->subscriber_ = self->participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  // Readers are created disabled and enabled once their owner holds them: Fast DDS may
+  // otherwise call a reader's listener before create_datareader() has returned.
+  fdds::SubscriberQos subscriber_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  subscriber_qos.entity_factory().autoenable_created_entities = false;
+  self->subscriber_ = self->participant_->create_subscriber(subscriber_qos);
   if (self->publisher_ == nullptr || self->subscriber_ == nullptr) {
     return fail(ErrorCode::unavailable,
                 "Fast DDS could not create the publisher or subscriber of '" + options.agent_id + "'");

@@ -46,6 +46,11 @@ Result<std::unique_ptr<ReaderCore>> ReaderCore::create(Participant& participant,
     return fail(ErrorCode::unavailable,
                 "Fast DDS could not create a reader on '" + self->spec_.topic + "'");
   }
+  // Created disabled (see Participant::create): no callback ran before reader_ was set.
+  if (self->reader_->enable() != ReturnCode_t::RETCODE_OK) {
+    return fail(ErrorCode::unavailable,
+                "Fast DDS could not enable the reader on '" + self->spec_.topic + "'");
+  }
   return self;
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 // Which generated TopicDataType (fastddsgen's <Type>PubSubType) serialises each message
 // type that travels as a topic sample. A message type is usable with Writer, Reader,
-// ServiceClient and ServiceServer once it is listed here.
+// ServiceClient and ServiceServer once it has a MessageTraits specialisation: listed
+// below, or declared next to its users with DROVER_DDS_MESSAGE(Type) at namespace
+// drover::dds scope (Type in drover::msg).
 
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
@@ -15,10 +17,10 @@ namespace drover::dds {
 template <class T>
 struct MessageTraits;
 
-#define DROVER_DDS_MESSAGE(Type)                                  \
-  template <>                                                     \
-  struct MessageTraits<msg::Type> {                               \
-    using PubSubType = msg::Type##PubSubType;                     \
+#define DROVER_DDS_MESSAGE(Type)              \
+  template <>                                 \
+  struct MessageTraits<msg::Type> {           \
+    using PubSubType = msg::Type##PubSubType; \
   }
 
 DROVER_DDS_MESSAGE(Heartbeat);
@@ -42,16 +44,15 @@ DROVER_DDS_MESSAGE(DelayReply);
 DROVER_DDS_MESSAGE(CancelRouteRequest);
 DROVER_DDS_MESSAGE(ReservationNotice);
 
-#undef DROVER_DDS_MESSAGE
-
 /// A TypeSupport that serialises T.
 template <class T>
 eprosima::fastdds::dds::TypeSupport type_support() {
   return eprosima::fastdds::dds::TypeSupport(new typename MessageTraits<T>::PubSubType());
 }
 
-/// Registers the type objects of every IDL file with Fast DDS's TypeObjectFactory, which
-/// content-filtered topics need. Idempotent and thread-safe; Participant::create calls it.
+/// Registers the type objects of every IDL file of idl/ with Fast DDS's TypeObjectFactory,
+/// which content-filtered topics need. Idempotent and thread-safe; Participant::create
+/// calls it.
 void register_type_objects();
 
 }  // namespace drover::dds
