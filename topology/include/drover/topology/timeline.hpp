@@ -182,6 +182,27 @@ struct TimelineSnapshot {
   friend bool operator==(const TimelineSnapshot&, const TimelineSnapshot&) = default;
 };
 
+/// Memory for many free-window queries of one agent on one TimelineSet that does not change
+/// meanwhile (a planner's search): what blocks the agent on each timeline is read once and
+/// reused for every entity whose windows depend on it. See
+/// TimelineSet::append_free_windows(entity, query, out). Implemented in timeline_query.cpp.
+class FreeWindowQuery {
+ public:
+  /// Starts a new series of queries for `agent` over [from, until), counting locks or not.
+  /// Forgets what was read before (the set may have changed since).
+  void start(std::string_view agent, TimeNs from, TimeNs until, bool count_locks = true);
+
+ private:
+  friend class TimelineSet;
+  std::string agent_;
+  TimeNs from_ = 0;
+  TimeNs until_ = 0;
+  bool count_locks_ = true;
+  std::uint32_t generation_ = 0;
+  std::vector<std::uint32_t> stamp_, first_, count_;  // per timeline, into blocked_
+  std::vector<Interval> blocked_;                     // sorted, disjoint, per timeline
+};
+
 /// The timelines of a set of entities (all of a topology, or one partition's).
 class TimelineSet {
  public:
@@ -228,6 +249,10 @@ class TimelineSet {
   void append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                            TimeNs until, std::vector<Interval>& out,
                            bool count_locks = true) const;
+  /// The same windows for the query's agent, interval and locks setting, reading each
+  /// timeline only once per query series. \pre the set has not changed since query.start.
+  void append_free_windows(EntityIndex entity, FreeWindowQuery& query,
+                           std::vector<Interval>& out) const;
 
   /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
   /// overlaps another agent's reservation or a lock, or if an expected version moved;
@@ -335,6 +360,11 @@ class TimelineSet {
 
  private:
   struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
+
+  /// Appends what keeps `agent` from writing on timeline x during [from, until) (clipped,
+  /// in no particular order): the free-window rule, in timeline_query.cpp.
+  void append_blocked(EntityIndex x, std::string_view agent, TimeNs from, TimeNs until,
+                      bool count_locks, std::vector<Interval>& out) const;
 
   /// Names one reservation of the set within a prepared set's (agent, route). Prepared
   /// sets remember keys, not copies, because a delay may move held items before commit.
