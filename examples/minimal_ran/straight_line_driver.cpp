@@ -31,6 +31,11 @@ void StraightLineDriver::start(StatusSink& sink, TimeNs now) {
   report(now);
 }
 
+void StraightLineDriver::stop(TimeNs now) {
+  advance(now);
+  sink_ = nullptr;  // the runner is going away: report no more
+}
+
 void StraightLineDriver::on_move(const MoveCommand& command, TimeNs now) {
   advance(now);
   // Driving straight from where the previous move ends: the swept footprint must stay

@@ -15,6 +15,7 @@ class StraightLineDriver final : public drover::ran::VehicleDriver {
   StraightLineDriver(std::string vehicle_id, drover::ran::Pose start);
 
   void start(drover::ran::StatusSink& sink, drover::TimeNs now) override;
+  void stop(drover::TimeNs now) override;
   void on_move(const drover::ran::MoveCommand& command, drover::TimeNs now) override;
   void on_action(const drover::ran::ActionCommand& command, drover::TimeNs now) override;
   void on_cancel(const drover::ran::CommandId& command, drover::TimeNs now) override;

@@ -10,6 +10,11 @@ void SimDriver::start(StatusSink& sink, TimeNs now) {
   report();
 }
 
+void SimDriver::stop(TimeNs now) {
+  vehicle_.advance_to(now);
+  sink_ = nullptr;
+}
+
 void SimDriver::on_move(const MoveCommand& command, TimeNs now) {
   vehicle_.advance_to(now);
   log_refusal("move", command.id, vehicle_.submit(command));

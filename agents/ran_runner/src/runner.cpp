@@ -166,6 +166,8 @@ RanRunner::~RanRunner() {
   tick_wake_.notify_all();
   if (tick_thread_.joinable()) tick_thread_.join();
   server_.reset();  // no handler runs after this
+  std::lock_guard lock(driver_mutex_);
+  driver_.stop(clock_.now());
 }
 
 void RanRunner::with_driver(const std::function<void(TimeNs now)>& action) {

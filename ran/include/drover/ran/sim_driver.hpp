@@ -12,6 +12,7 @@ class SimDriver final : public VehicleDriver {
   explicit SimDriver(SimVehicle vehicle) : vehicle_(std::move(vehicle)) {}
 
   void start(StatusSink& sink, TimeNs now) override;
+  void stop(TimeNs now) override;
   void on_move(const MoveCommand& command, TimeNs now) override;
   void on_action(const ActionCommand& command, TimeNs now) override;
   void on_cancel(const CommandId& command, TimeNs now) override;

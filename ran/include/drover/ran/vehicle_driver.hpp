@@ -51,9 +51,12 @@ class VehicleDriver {
  public:
   virtual ~VehicleDriver() = default;
 
-  /// The runner is ready; from now on report through `sink` (which outlives the driver's
-  /// use of it). Report the initial status here.
+  /// The runner is ready; from now on report through `sink`, until stop(). Report the
+  /// initial status here.
   virtual void start(StatusSink& sink, TimeNs now) = 0;
+  /// The runner is shutting down: the sink must not be used once this returns (stop any
+  /// thread that reports). No other member is called afterwards. Default: nothing.
+  virtual void stop(TimeNs now) { (void)now; }
   /// Queue a move after the commands already queued.
   virtual void on_move(const MoveCommand& command, TimeNs now) = 0;
   /// Queue an action after the commands already queued.

@@ -42,7 +42,8 @@ class RanRunner {
   /// Contract: `participant` and `driver` outlive the runner.
   static Result<std::unique_ptr<RanRunner>> create(dds::Participant& participant, SharedClock clock,
                                                    VehicleDriver& driver, RanRunnerOptions options);
-  /// Stops ticking and serving; the driver is not called after this returns.
+  /// Stops ticking and serving, then stops the driver (VehicleDriver::stop); the driver is
+  /// not called after this returns.
   ~RanRunner();
 
   /// Runs `action` with the driver's lock held (never concurrently with a driver call),
