@@ -23,7 +23,7 @@ Result<std::unique_ptr<AgentDirectory>> AgentDirectory::create(Participant& part
 
   TopicQos qos = TopicQos::state();
   qos.deadline = directory->options_.deadline;
-  detail::ReaderSpec spec{kHeartbeatTopic, type_support<msg::Heartbeat>(), qos, {}, {},
+  detail::ReaderSpec spec{kHeartbeatTopic, type_support<msg::Heartbeat>(), qos, {}, {}, {},
                           detail::Dispatch::own_thread};
   auto reader = detail::ReaderCore::create(
       participant, std::move(spec),

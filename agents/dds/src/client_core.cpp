@@ -1,5 +1,7 @@
 #include "drover/dds/detail/client_core.hpp"
 
+#include "drover/dds/detail/requester_filter.hpp"
+
 #include <algorithm>
 #include <utility>
 #include <vector>
@@ -30,9 +32,10 @@ Result<std::unique_ptr<ClientCore>> ClientCore::create(Participant& participant,
   ClientCore* core = self.get();
 
   // Replies reach only their requester: the filter keeps samples whose header names this
-  // agent (the parameter is a single-quoted string, as Fast DDS's SQL filter wants).
-  ReaderSpec reply_spec{core->topics_.reply, std::move(reply_type), TopicQos::service(),
-                        "header.requester = %0", {"'" + participant.agent_id() + "'"},
+  // agent (evaluated by the server's writer for each client's reader).
+  ReaderSpec reply_spec{core->topics_.reply,         std::move(reply_type),
+                        TopicQos::service(),         kRequesterFilterExpression,
+                        {participant.agent_id()},    kRequesterFilterClass,
                         Dispatch::listener_thread};
   auto reader = ReaderCore::create(
       participant, std::move(reply_spec),

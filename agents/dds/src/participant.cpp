@@ -10,6 +10,8 @@
 #include <fastdds/rtps/participant/ParticipantDiscoveryInfo.h>
 #include <spdlog/spdlog.h>
 
+#include "drover/dds/detail/requester_filter.hpp"
+
 namespace drover::dds {
 
 namespace fdds = eprosima::fastdds::dds;
@@ -138,6 +140,11 @@ Result<std::unique_ptr<Participant>> Participant::create(const ParticipantOption
     std::lock_guard lock(self->discovery_mutex_);
     self->names_[self->participant_->guid().guidPrefix] = options.agent_id;
   }
+  if (self->participant_->register_content_filter_factory(
+          detail::kRequesterFilterClass, &detail::RequesterFilterFactory::instance()) !=
+      ReturnCode_t::RETCODE_OK) {
+    return fail(ErrorCode::internal, "cannot register the requester content filter");
+  }
   self->publisher_ = self->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   // Readers are created disabled and enabled once their owner holds them: Fast DDS may
   // otherwise call a reader's listener before create_datareader() has returned.
@@ -185,14 +192,18 @@ Result<fdds::Topic*> Participant::find_or_create_topic(const std::string& name,
 }
 
 Result<fdds::ContentFilteredTopic*> Participant::create_filtered_topic(
-    fdds::Topic& related, const std::string& expression, const std::vector<std::string>& parameters) {
+    fdds::Topic& related, const std::string& expression, const std::vector<std::string>& parameters,
+    const std::string& filter_class) {
   std::string name;
   {
     std::lock_guard lock(topics_mutex_);
     name = related.get_name() + "#filtered" + std::to_string(++filtered_topic_count_);
   }
   fdds::ContentFilteredTopic* topic =
-      participant_->create_contentfilteredtopic(name, &related, expression, parameters);
+      filter_class.empty()
+          ? participant_->create_contentfilteredtopic(name, &related, expression, parameters)
+          : participant_->create_contentfilteredtopic(name, &related, expression, parameters,
+                                                      filter_class.c_str());
   if (topic == nullptr) {
     return fail(ErrorCode::invalid_argument, "Fast DDS rejected the content filter '" + expression +
                                                  "' on topic '" + related.get_name() + "'");

@@ -33,7 +33,8 @@ Result<std::unique_ptr<ReaderCore>> ReaderCore::create(Participant& participant,
   fdds::TopicDescription* description = *topic;
   if (!self->spec_.filter_expression.empty()) {
     auto filtered = participant.create_filtered_topic(**topic, self->spec_.filter_expression,
-                                                      self->spec_.filter_parameters);
+                                                      self->spec_.filter_parameters,
+                                                      self->spec_.filter_class);
     if (!filtered) return unexpected(filtered.error());
     self->filtered_topic_ = *filtered;
     description = *filtered;

@@ -69,7 +69,7 @@ Result<std::unique_ptr<ServerCore>> ServerCore::create(Participant& participant,
   if (!writer) return unexpected(writer.error());
   self->channel_->attach(std::move(*writer));
 
-  ReaderSpec request_spec{topics.request, std::move(request_type), TopicQos::service(), {}, {},
+  ReaderSpec request_spec{topics.request, std::move(request_type), TopicQos::service(), {}, {}, {},
                           Dispatch::own_thread};
   auto reader = ReaderCore::create(
       participant, std::move(request_spec),

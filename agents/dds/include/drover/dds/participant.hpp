@@ -95,13 +95,14 @@ class Participant {
   Result<eprosima::fastdds::dds::Topic*> find_or_create_topic(
       const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
-  /// A new content-filtered view of `related` (default SQL-like filter; parameters as
-  /// Fast DDS wants them, strings single-quoted). The caller deletes it with
-  /// delete_filtered_topic() after the readers that use it.
+  /// A new content-filtered view of `related`. With an empty `filter_class`, Fast DDS's
+  /// default SQL-like filter (parameters as it wants them: strings single-quoted); or a
+  /// class registered on every Participant (detail::kRequesterFilterClass). The caller
+  /// deletes it with delete_filtered_topic() after the readers that use it.
   /// \return the topic, or invalid_argument when Fast DDS rejects the expression.
   Result<eprosima::fastdds::dds::ContentFilteredTopic*> create_filtered_topic(
       eprosima::fastdds::dds::Topic& related, const std::string& expression,
-      const std::vector<std::string>& parameters);
+      const std::vector<std::string>& parameters, const std::string& filter_class = {});
   void delete_filtered_topic(eprosima::fastdds::dds::ContentFilteredTopic* topic);
 
   /// The name of a participant seen by discovery (or of this one), if known.

@@ -37,9 +37,13 @@ class Reader {
   ///         carries another type), or unavailable.
   static Result<std::unique_ptr<Reader>> create(Participant& participant, const std::string& topic,
                                                 Callback callback, ReaderOptions options = {}) {
-    detail::ReaderSpec spec{topic, type_support<T>(), options.qos,
+    detail::ReaderSpec spec{topic,
+                            type_support<T>(),
+                            options.qos,
                             std::move(options.filter_expression),
-                            std::move(options.filter_parameters), detail::Dispatch::own_thread};
+                            std::move(options.filter_parameters),
+                            {},
+                            detail::Dispatch::own_thread};
     auto core = detail::ReaderCore::create(
         participant, std::move(spec),
         [callback = std::move(callback)](std::shared_ptr<void>& sample,

@@ -34,9 +34,11 @@ struct ReaderSpec {
   std::string topic;
   eprosima::fastdds::dds::TypeSupport type;
   TopicQos qos;
-  /// Content filter (default SQL-like filter) on the topic; empty: every sample.
+  /// Content filter on the topic; empty: every sample. See
+  /// Participant::create_filtered_topic for the class (empty: default SQL-like filter).
   std::string filter_expression;
   std::vector<std::string> filter_parameters;
+  std::string filter_class;
   Dispatch dispatch = Dispatch::own_thread;
 };
 
