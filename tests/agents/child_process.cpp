@@ -1,5 +1,6 @@
 #include "tests/agents/child_process.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,15 +11,18 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <utility>
 
 extern char** environ;
 
 namespace drover::test {
 
-std::optional<ChildProcess> ChildProcess::spawn(const std::string& path,
-                                                const std::vector<std::string>& args) {
+std::optional<ChildProcess> ChildProcess::spawn(const std::string& path, const std::vector<std::string>& args,
+                                                const std::string& stdout_file,
+                                                const std::string& stderr_file) {
   std::vector<std::string> argv_storage;
   argv_storage.push_back(path);
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
@@ -26,9 +30,15 @@ std::optional<ChildProcess> ChildProcess::spawn(const std::string& path,
   for (auto& arg : argv_storage) argv.push_back(arg.data());
   argv.push_back(nullptr);
 
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  constexpr int kFlags = O_WRONLY | O_CREAT | O_TRUNC;
+  if (!stdout_file.empty()) posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, stdout_file.c_str(), kFlags, 0644);
+  if (!stderr_file.empty()) posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_file.c_str(), kFlags, 0644);
   pid_t pid = -1;
-  if (const int error = posix_spawn(&pid, path.c_str(), nullptr, nullptr, argv.data(), environ);
-      error != 0) {
+  const int error = posix_spawn(&pid, path.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) {
     std::cerr << "cannot start " << path << ": " << std::strerror(error) << "\n";
     return std::nullopt;
   }
@@ -70,6 +80,13 @@ std::optional<ExitStatus> ChildProcess::wait_exit(std::chrono::milliseconds time
   pid_ = -1;
   if (WIFEXITED(status)) return ExitStatus{true, WEXITSTATUS(status)};
   return ExitStatus{false, WIFSIGNALED(status) ? WTERMSIG(status) : 0};
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 std::string binary_path(const std::string& name) {

@@ -20,9 +20,12 @@ struct ExitStatus {
 
 class ChildProcess {
  public:
-  /// Starts `path` with `args`. \return the child, or nullopt when it could not start
+  /// Starts `path` with `args`, its stdout and stderr written to the given files when not
+  /// empty (inherited otherwise). \return the child, or nullopt when it could not start
   /// (the reason is printed).
-  static std::optional<ChildProcess> spawn(const std::string& path, const std::vector<std::string>& args);
+  static std::optional<ChildProcess> spawn(const std::string& path, const std::vector<std::string>& args,
+                                           const std::string& stdout_file = {},
+                                           const std::string& stderr_file = {});
 
   ChildProcess(ChildProcess&& other) noexcept;
   ChildProcess& operator=(ChildProcess&&) = delete;
@@ -44,5 +47,8 @@ class ChildProcess {
 
 /// DROVER_BINARY_DIR/bin/<name>: where the build puts executables.
 std::string binary_path(const std::string& name);
+
+/// The whole content of a file ("" when it cannot be read).
+std::string read_file(const std::string& path);
 
 }  // namespace drover::test

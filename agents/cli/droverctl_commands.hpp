@@ -1,0 +1,15 @@
+#pragma once
+// `droverctl`, the operator tool: every command registers itself on the CLI11 app and
+// reports its exit code through CommandContext (0 ok, 1 failure, 2 bad usage or input,
+// 3 no agent answered).
+
+#include <CLI/CLI.hpp>
+
+#include "agents/cli/command.hpp"
+
+namespace drover::cli {
+
+/// `droverctl agents`: the live agents, from their heartbeats.
+void add_agents_command(CLI::App& app, CommandContext& context);
+
+}  // namespace drover::cli

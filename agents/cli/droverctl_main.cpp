@@ -1,0 +1,36 @@
+// `droverctl`: the operator tool. Each command is a subcommand (agents_command.cpp, ...).
+
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "agents/cli/droverctl_commands.hpp"
+
+int main(int argc, char** argv) {
+  using namespace drover::cli;
+  CLI::App app{"droverctl: inspect and operate a running Drover fleet.", "droverctl"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "droverctl 0.1.0");
+
+  CommandContext context;
+  add_agents_command(app, context);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    // Commands turn expected failures into messages themselves; this is the last guard.
+    std::cerr << "error: internal: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  return context.exit_code;
+}
