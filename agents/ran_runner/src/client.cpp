@@ -44,7 +44,6 @@ Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participa
                                                      std::size_t history_limit,
                                                      StatusCallback on_status) {
   if (ran_agent.empty()) ran_agent = ran_agent_id(vehicle_id);
-  register_ran_type_objects();
   std::unique_ptr<RanClient> client(new RanClient(std::move(vehicle_id), std::move(ran_agent),
                                                   history_limit, std::move(on_status)));
   auto commands = CommandClient::create(participant, kServiceArea, kCommandService);

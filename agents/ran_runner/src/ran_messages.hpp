@@ -1,39 +1,17 @@
 #pragma once
 // Makes the RAN messages of idl/ran.idl usable with the DDS layer's Writer, Reader and
-// services (its MessageTraits), and registers their type objects, which content-filtered
-// topics need, before the first use.
+// services. (Their type objects, which content filters need, are registered with every
+// IDL's by Participant::create.)
 
 #include "drover/dds/message_types.hpp"
 #include "ranPubSubTypes.h"
 
 namespace drover::dds {
 
-template <>
-struct MessageTraits<msg::RanCommandRequest> {
-  using PubSubType = msg::RanCommandRequestPubSubType;
-};
-template <>
-struct MessageTraits<msg::RanCommandReply> {
-  using PubSubType = msg::RanCommandReplyPubSubType;
-};
-template <>
-struct MessageTraits<msg::RanStatus> {
-  using PubSubType = msg::RanStatusPubSubType;
-};
-template <>
-struct MessageTraits<msg::SimFaultRequest> {
-  using PubSubType = msg::SimFaultRequestPubSubType;
-};
-template <>
-struct MessageTraits<msg::SimFaultReply> {
-  using PubSubType = msg::SimFaultReplyPubSubType;
-};
+DROVER_DDS_MESSAGE(RanCommandRequest);
+DROVER_DDS_MESSAGE(RanCommandReply);
+DROVER_DDS_MESSAGE(RanStatus);
+DROVER_DDS_MESSAGE(SimFaultRequest);
+DROVER_DDS_MESSAGE(SimFaultReply);
 
 }  // namespace drover::dds
-
-namespace drover::ran {
-
-/// Registers the type objects of idl/ran.idl once (thread-safe, idempotent).
-void register_ran_type_objects();
-
-}  // namespace drover::ran

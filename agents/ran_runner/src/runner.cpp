@@ -143,7 +143,6 @@ Result<std::unique_ptr<RanRunner>> RanRunner::create(dds::Participant& participa
     return fail(ErrorCode::invalid_argument, "ran runner: status period must be positive");
   }
   std::unique_ptr<RanRunner> runner(new RanRunner(clock, driver, std::move(options)));
-  register_ran_type_objects();
   auto writer = dds::Writer<msg::RanStatus>::create(participant, kStatusTopic);
   if (!writer) return unexpected(writer.error());
   runner->sink_ = std::make_unique<Sink>(std::move(*writer));

@@ -28,7 +28,6 @@ Result<std::unique_ptr<SimFaultServer>> SimFaultServer::create(dds::Participant&
                                                                RanRunner& runner,
                                                                SimDriver& driver) {
   std::unique_ptr<SimFaultServer> faults(new SimFaultServer(runner, driver));
-  register_ran_type_objects();
   auto server = Server::create(
       participant, kServiceArea, kSimFaultService,
       [raw = faults.get()](const msg::SimFaultRequest& request,
