@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <string>
@@ -127,6 +128,67 @@ TEST(TopicTest, OneTopicNameCarriesOneType) {
   ASSERT_FALSE(second.has_value());
   EXPECT_EQ(second.error().code, ErrorCode::conflict);
   EXPECT_NE(second.error().message.find("drover/test/mixed"), std::string::npos);
+}
+
+std::string write_temp_file(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ParticipantTest, TakesTransportsFromANamedXmlProfile) {
+  constexpr std::uint32_t kDomain = 134;
+  const std::string profiles = write_temp_file("drover_udp_only.xml", R"(<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <transport_descriptors>
+    <transport_descriptor>
+      <transport_id>drover_test_udp</transport_id>
+      <type>UDPv4</type>
+    </transport_descriptor>
+  </transport_descriptors>
+  <participant profile_name="drover_udp_only">
+    <rtps>
+      <userTransports><transport_id>drover_test_udp</transport_id></userTransports>
+      <useBuiltinTransports>false</useBuiltinTransports>
+    </rtps>
+  </participant>
+</profiles>
+)");
+  dds::ParticipantOptions options;
+  options.domain_id = kDomain;
+  options.xml_profile_file = profiles;
+  options.profile_name = "drover_udp_only";
+  options.agent_id = "udp-writer";
+  auto writer_side = dds::Participant::create(options);
+  ASSERT_TRUE(writer_side.has_value()) << writer_side.error().message;
+  options.agent_id = "udp-reader";
+  auto reader_side = dds::Participant::create(options);
+  ASSERT_TRUE(reader_side.has_value()) << reader_side.error().message;
+  EXPECT_FALSE((*writer_side)->native().get_qos().transport().use_builtin_transports);
+  EXPECT_EQ((*writer_side)->native().get_qos().name().to_string(), "udp-writer");
+
+  auto writer = dds::Writer<msg::TimelineState>::create(**writer_side, "drover/test/udp");
+  ASSERT_TRUE(writer.has_value());
+  ASSERT_TRUE((*writer)->write(timeline("e9", 4)).has_value());
+  Inbox<msg::TimelineState> inbox;
+  auto reader = dds::Reader<msg::TimelineState>::create(**reader_side, "drover/test/udp",
+                                                        [&](const msg::TimelineState& s) { inbox.push(s); });
+  ASSERT_TRUE(reader.has_value());
+  ASSERT_TRUE(inbox.wait_for_count(1));
+  EXPECT_EQ(inbox.samples().front().version(), 4u);
+
+  options.profile_name = "no_such_profile";
+  auto unknown = dds::Participant::create(options);
+  ASSERT_FALSE(unknown.has_value());
+  EXPECT_EQ(unknown.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(unknown.error().message.find("no_such_profile"), std::string::npos);
+
+  options.profile_name.clear();
+  options.xml_profile_file = write_temp_file("drover_broken.xml", "<profiles><participant");
+  auto broken = dds::Participant::create(options);
+  ASSERT_FALSE(broken.has_value());
+  EXPECT_EQ(broken.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(broken.error().message.find("drover_broken.xml"), std::string::npos) << broken.error().message;
 }
 
 TEST(ParticipantTest, RejectsBadAgentIdsAndOptionsWithClearErrors) {
