@@ -1,0 +1,18 @@
+#pragma once
+// Where logical agents meet their clients on DDS (docs/logical-agent.md, "On the wire").
+// A logical agent's id is its vehicle's id; its RAN's id is ran::ran_agent_id(vehicle id).
+
+namespace drover::logical_agent {
+
+/// Service drover/logical/order/{request,reply}: OrderRequest / OrderReply, addressed to
+/// one logical agent through header.responder.
+inline constexpr const char* kServiceArea = "logical";
+inline constexpr const char* kOrderService = "order";
+/// State topic of OrderProgress, keyed on the order name.
+inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progress";
+/// State topic of VehicleState, keyed on the vehicle id.
+inline constexpr const char* kVehicleStateTopic = "drover/logical/vehicle";
+/// Event topic of OperatorAlarm (RELIABLE + VOLATILE + KEEP_ALL).
+inline constexpr const char* kAlarmTopic = "drover/operator/alarm";
+
+}  // namespace drover::logical_agent
