@@ -1,0 +1,56 @@
+#include "agents/logical_agent/src/footprint_monitor.hpp"
+
+#include <boost/geometry.hpp>
+
+#include "drover/ran/motion_area.hpp"
+
+namespace drover::logical_agent {
+
+namespace bg = boost::geometry;
+
+FootprintMonitor::FootprintMonitor(std::shared_ptr<const topology::Topology> topology, double tolerance_m2)
+    : topology_(std::move(topology)), tolerance_m2_(tolerance_m2) {}
+
+void FootprintMonitor::hold(topology::EntityIndex entity, std::optional<std::size_t> step) {
+  held_[entity] = step;
+  area_.reset();
+}
+
+void FootprintMonitor::drop(topology::EntityIndex entity) {
+  held_.erase(entity);
+  area_.reset();
+}
+
+void FootprintMonitor::forget_steps() {
+  for (auto& [entity, step] : held_) step.reset();
+}
+
+std::vector<topology::EntityIndex> FootprintMonitor::held() const {
+  std::vector<topology::EntityIndex> out;
+  for (const auto& [entity, step] : held_) out.push_back(entity);
+  return out;
+}
+
+void FootprintMonitor::rebuild_area() const {
+  ran::MotionArea parts;
+  for (const auto& [entity, step] : held_) parts.push_back(topology_->footprint(entity));
+  area_ = ran::normalized_area(parts);
+}
+
+double FootprintMonitor::area_outside(const topology::Polygon& footprint) const {
+  if (!area_) rebuild_area();
+  return ran::area_outside(footprint, *area_);
+}
+
+std::vector<topology::EntityIndex> FootprintMonitor::releasable(const topology::Polygon& footprint,
+                                                                std::size_t passed_step) const {
+  std::vector<topology::EntityIndex> out;
+  for (const auto& [entity, step] : held_) {
+    if (step && *step > passed_step) continue;
+    if (bg::intersects(footprint, topology_->footprint(entity))) continue;
+    out.push_back(entity);
+  }
+  return out;
+}
+
+}  // namespace drover::logical_agent

@@ -1,0 +1,122 @@
+#include "agents/logical_agent/src/order_book.hpp"
+
+#include <algorithm>
+
+namespace drover::logical_agent {
+
+const char* to_string(OrderState state) noexcept {
+  switch (state) {
+    case OrderState::queued: return "queued";
+    case OrderState::running: return "running";
+    case OrderState::finished: return "finished";
+    case OrderState::failed: return "failed";
+  }
+  return "unknown";
+}
+
+std::optional<ran::ActionCommand> operation_action(const Destination& destination) {
+  const std::string& operation = destination.operation;
+  if (operation.empty() || operation == "NOP" || operation == "park") return std::nullopt;
+  ran::ActionCommand action;
+  if (const auto kind = ran::action_kind_from_string(operation)) {
+    action.kind = *kind;
+  } else {
+    action.kind = ran::ActionKind::custom;
+  }
+  action.name = operation;
+  action.parameters = destination.properties;
+  return action;
+}
+
+Result<Order> make_order(const topology::Topology& topology, const OrderSpec& spec) {
+  if (spec.name.empty()) return fail(ErrorCode::invalid_argument, "order: the name is empty");
+  if (spec.destinations.empty()) {
+    return fail(ErrorCode::invalid_argument, "order '" + spec.name + "': no destination");
+  }
+  Order order;
+  order.name = spec.name;
+  order.properties = spec.properties;
+  for (std::size_t i = 0; i < spec.destinations.size(); ++i) {
+    const auto& stop = spec.destinations[i];
+    const auto entity = topology.find(stop.location);
+    if (!entity || !topology.is_vertex(*entity)) {
+      return fail(ErrorCode::invalid_argument, "order '" + spec.name + "': destination " + std::to_string(i) +
+                                                   ": '" + stop.location + "' is not a vertex of topology '" +
+                                                   topology.name() + "'");
+    }
+    order.destinations.push_back(Destination{*entity, stop.location, stop.operation, stop.properties});
+  }
+  return order;
+}
+
+Result<std::size_t> OrderBook::add(Order order, TimeNs now) {
+  if (find(order.name) != nullptr) {
+    return fail(ErrorCode::conflict, "order '" + order.name + "' is known already");
+  }
+  order.state = OrderState::queued;
+  order.destination = 0;
+  order.created = now;
+  orders_.push_back(std::move(order));
+  publish(orders_.back());
+  return static_cast<std::size_t>(std::count_if(orders_.begin(), orders_.end(), [](const Order& o) {
+    return o.state == OrderState::queued || o.state == OrderState::running;
+  }));
+}
+
+Order* OrderBook::running() {
+  for (auto& order : orders_) {
+    if (order.state == OrderState::running) return &order;
+  }
+  return nullptr;
+}
+
+const Order* OrderBook::current() const { return const_cast<OrderBook*>(this)->running(); }
+
+const Order* OrderBook::start_next(TimeNs now) {
+  if (Order* order = running()) return order;
+  for (auto& order : orders_) {
+    if (order.state != OrderState::queued) continue;
+    order.state = OrderState::running;
+    order.started = now;
+    publish(order);
+    return &order;
+  }
+  return nullptr;
+}
+
+bool OrderBook::advance(TimeNs now) {
+  Order* order = running();
+  if (order == nullptr) return false;
+  ++order->destination;
+  if (order->destination >= order->destinations.size()) {
+    order->state = OrderState::finished;
+    order->finished = now;
+    publish(*order);
+    return false;
+  }
+  publish(*order);
+  return true;
+}
+
+void OrderBook::fail_current(const std::string& reason, TimeNs now) {
+  Order* order = running();
+  if (order == nullptr) return;
+  order->state = OrderState::failed;
+  order->finished = now;
+  order->failure = reason;
+  publish(*order);
+}
+
+std::size_t OrderBook::queued_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(orders_.begin(), orders_.end(), [](const Order& o) { return o.state == OrderState::queued; }));
+}
+
+const Order* OrderBook::find(const std::string& name) const {
+  for (const auto& order : orders_) {
+    if (order.name == name) return &order;
+  }
+  return nullptr;
+}
+
+}  // namespace drover::logical_agent

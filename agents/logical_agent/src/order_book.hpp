@@ -1,0 +1,101 @@
+#pragma once
+// The order queue of one logical agent (no DDS): orders are validated against the topology
+// when they arrive, executed one at a time in arrival order, each destination in turn, and
+// every change of an order is reported to an observer (the agent publishes it).
+
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drover/common/clock.hpp"
+#include "drover/common/result.hpp"
+#include "drover/ran/commands.hpp"
+#include "drover/topology/model.hpp"
+
+namespace drover::logical_agent {
+
+/// One stop of an order: a vertex and what to do there.
+struct Destination {
+  topology::EntityIndex location = topology::kNoEntity;
+  std::string location_id;
+  std::string operation;  ///< "NOP"/empty, "park", "load", "unload", "charge" or a custom name
+  std::map<std::string, std::string> properties;
+};
+
+enum class OrderState { queued, running, finished, failed };
+const char* to_string(OrderState state) noexcept;
+
+struct Order {
+  std::string name;
+  std::vector<Destination> destinations;
+  std::map<std::string, std::string> properties;
+  OrderState state = OrderState::queued;
+  std::size_t destination = 0;  ///< index of the destination being executed
+  TimeNs created = 0;
+  std::optional<TimeNs> started;
+  std::optional<TimeNs> finished;
+  std::string failure;
+};
+
+/// The RAN action an operation asks for at its location; nullopt when it asks for none
+/// ("NOP", empty, "park": the vehicle only drives there).
+std::optional<ran::ActionCommand> operation_action(const Destination& destination);
+
+/// An order as requested: name and destinations by vertex id.
+struct OrderSpec {
+  std::string name;
+  struct Stop {
+    std::string location;
+    std::string operation;
+    std::map<std::string, std::string> properties;
+  };
+  std::vector<Stop> destinations;
+  std::map<std::string, std::string> properties;
+};
+
+/// Checks a requested order against the topology.
+/// \return the order (queued, not yet timed), or invalid_argument naming the problem: an
+///         empty name, no destination, a location (by destination index) that is not a
+///         vertex of the topology.
+Result<Order> make_order(const topology::Topology& topology, const OrderSpec& spec);
+
+/// Not thread-safe: the agent guards it with its mutex.
+class OrderBook {
+ public:
+  /// Called with the order after every change (queued, started, advanced, ended).
+  using Observer = std::function<void(const Order&)>;
+  explicit OrderBook(Observer observer) : observer_(std::move(observer)) {}
+
+  /// Queues `order` at `now`. \return its 1-based position among the unfinished orders,
+  ///         or conflict when an order of that name is known (nothing changes).
+  Result<std::size_t> add(Order order, TimeNs now);
+
+  /// The order being executed, if any.
+  const Order* current() const;
+  /// Starts the oldest queued order at `now` when none runs. \return the running order.
+  const Order* start_next(TimeNs now);
+  /// The running order's current destination is done: moves to the next one.
+  /// \return true when the order has more destinations; false when it finished (at `now`).
+  bool advance(TimeNs now);
+  /// Fails the running order with `reason` at `now` (no-op when none runs).
+  void fail_current(const std::string& reason, TimeNs now);
+
+  /// Orders waiting behind the running one.
+  std::size_t queued_count() const;
+  const Order* find(const std::string& name) const;
+
+ private:
+  Order* running();
+  void publish(const Order& order) const {
+    if (observer_) observer_(order);
+  }
+
+  Observer observer_;
+  std::deque<Order> orders_;  ///< in arrival order; ended ones stay for lookups
+};
+
+}  // namespace drover::logical_agent

@@ -1,0 +1,24 @@
+#pragma once
+// Vehicle profiles as JSON files: an object with any of id, type (strings) and max_speed,
+// acceleration, deceleration, length, width, payload (numbers, SI units); fields left out
+// keep carp::VehicleProfile's defaults. Example: {"id": "V1", "max_speed": 1.0,
+// "acceleration": 0.5, "deceleration": 0.5, "length": 0.6, "width": 0.4}.
+
+#include <string>
+
+#include "drover/carp/vehicle.hpp"
+#include "drover/common/result.hpp"
+
+namespace drover::carp {
+
+/// Parses a profile from JSON text; `where` names the source in messages (a file name).
+/// \return the validated profile, or parse (not JSON, not an object, a field of the wrong
+///         type, an unknown field) or invalid_argument (a value out of range), each naming
+///         `where` and the field.
+Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where);
+
+/// Reads and parses the file at `path`. \return as parse_vehicle_profile, or io when the
+///         file cannot be read.
+Result<VehicleProfile> read_vehicle_profile(const std::string& path);
+
+}  // namespace drover::carp

@@ -1,0 +1,54 @@
+#include "drover/carp/vehicle_profile_json.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace drover::carp {
+
+Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    return fail(ErrorCode::parse, where + ": not valid JSON: " + e.what());
+  }
+  if (!json.is_object()) return fail(ErrorCode::parse, where + ": a vehicle profile is a JSON object");
+  VehicleProfile vehicle;
+  for (const auto& [key, value] : json.items()) {
+    std::string* text_field = key == "id" ? &vehicle.id : key == "type" ? &vehicle.type : nullptr;
+    double* number = key == "max_speed"      ? &vehicle.max_speed
+                     : key == "acceleration" ? &vehicle.acceleration
+                     : key == "deceleration" ? &vehicle.deceleration
+                     : key == "length"       ? &vehicle.length
+                     : key == "width"        ? &vehicle.width
+                     : key == "payload"      ? &vehicle.payload
+                                             : nullptr;
+    if (text_field != nullptr) {
+      if (!value.is_string()) return fail(ErrorCode::parse, where + ": " + key + ": must be a string");
+      *text_field = value.get<std::string>();
+    } else if (number != nullptr) {
+      if (!value.is_number()) return fail(ErrorCode::parse, where + ": " + key + ": must be a number");
+      *number = value.get<double>();
+    } else {
+      return fail(ErrorCode::parse, where + ": " + key +
+                                        ": unknown field (known: id, type, max_speed, acceleration, "
+                                        "deceleration, length, width, payload)");
+    }
+  }
+  if (auto valid = validate(vehicle); !valid) {
+    return fail(ErrorCode::invalid_argument, where + ": " + valid.error().message);
+  }
+  return vehicle;
+}
+
+Result<VehicleProfile> read_vehicle_profile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return fail(ErrorCode::io, path + ": cannot read the vehicle profile");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_vehicle_profile(text.str(), path);
+}
+
+}  // namespace drover::carp

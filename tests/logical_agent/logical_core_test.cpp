@@ -1,0 +1,255 @@
+// The logical agent's logic without DDS: order queue, route tracking (allocation look-ahead,
+// moves only onto allocated steps, delays, lateness), footprint monitoring and release,
+// travel-time estimates, vehicle profile files. On the bundled H-shaped crossing.
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "agents/logical_agent/src/footprint_monitor.hpp"
+#include "agents/logical_agent/src/order_book.hpp"
+#include "agents/logical_agent/src/route_tracker.hpp"
+#include "agents/logical_agent/src/travel_time.hpp"
+#include "drover/carp/vehicle_profile_json.hpp"
+#include "drover/ran/motion_area.hpp"
+#include "drover/ran/status.hpp"
+#include "drover/topology/topology_file.hpp"
+
+namespace drover::logical_agent {
+namespace {
+
+std::shared_ptr<const topology::Topology> h_crossing() {
+  const char* source = std::getenv("DROVER_SOURCE_DIR");
+  const std::string path = std::string(source ? source : ".") + "/launch/topologies/h_crossing.json";
+  auto loaded = topology::load_topology_file(path);
+  if (!loaded) throw std::runtime_error("cannot load " + path);
+  return std::make_shared<const topology::Topology>(std::move(*loaded));
+}
+
+topology::EntityIndex index(const topology::Topology& world, const std::string& id) {
+  auto found = world.find(id);
+  if (!found) throw std::runtime_error("no entity " + id);
+  return *found;
+}
+
+/// left-0 -> left-1 -> left-2 -> bar-1, one second per metre, 1 s clearance.
+RouteTracker left_route(const std::shared_ptr<const topology::Topology>& world) {
+  const std::vector<std::string> ids = {"left-0", "left-0<->left-1", "left-1", "left-1<->left-2",
+                                        "left-2", "left-2<->bar-1",  "bar-1"};
+  std::vector<topology::RouteStep> steps;
+  TimeNs t = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const auto entity = index(*world, ids[i]);
+    const bool vertex = i % 2 == 0;
+    const DurationNs stay = vertex ? 0 : seconds_to_ns(world->edge(entity).length);
+    const TimeNs end = i + 1 == ids.size() ? kForever : t + stay + seconds_to_ns(1);
+    steps.push_back(topology::RouteStep{entity, {t, end}});
+    t += stay;
+  }
+  return RouteTracker(world, 42, std::move(steps));
+}
+
+ran::VehicleStatus status_at(double x, double y, double theta = 0) {
+  ran::VehicleStatus status;
+  status.pose = {x, y, theta};
+  topology::Polygon shape;
+  for (auto [px, py] : {std::pair{-0.3, -0.2}, {-0.3, 0.2}, {0.3, 0.2}, {0.3, -0.2}, {-0.3, -0.2}}) {
+    shape.outer().emplace_back(px, py);
+  }
+  status.footprint = ran::footprint_at(shape, status.pose);
+  return status;
+}
+
+// ---- orders ----
+
+TEST(OrderBook, ValidatesLocationsAgainstTheTopology) {
+  const auto world = h_crossing();
+  auto bad = make_order(*world, OrderSpec{"o1", {{"left-4", "load", {}}, {"nowhere", "unload", {}}}, {}});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(bad.error().message.find("destination 1: 'nowhere'"), std::string::npos) << bad.error().message;
+  auto edge = make_order(*world, OrderSpec{"o2", {{"left-0<->left-1", "NOP", {}}}, {}});
+  ASSERT_FALSE(edge);
+  EXPECT_FALSE(make_order(*world, OrderSpec{"o3", {}, {}}));
+  EXPECT_FALSE(make_order(*world, OrderSpec{"", {{"left-4", "", {}}}, {}}));
+}
+
+TEST(OrderBook, RunsOrdersInArrivalOrderThroughEveryDestination) {
+  const auto world = h_crossing();
+  std::vector<std::string> seen;
+  OrderBook book([&](const Order& order) {
+    seen.push_back(order.name + ":" + to_string(order.state) + ":" + std::to_string(order.destination));
+  });
+  auto first = make_order(*world, OrderSpec{"a", {{"left-4", "load", {}}, {"right-4", "unload", {}}}, {}});
+  auto second = make_order(*world, OrderSpec{"b", {{"left-0", "park", {}}}, {}});
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(book.add(*first, 10).value(), 1u);
+  EXPECT_EQ(book.add(*second, 11).value(), 2u);
+  auto duplicate = book.add(*first, 12);
+  ASSERT_FALSE(duplicate);
+  EXPECT_EQ(duplicate.error().code, ErrorCode::conflict);
+
+  const Order* running = book.start_next(20);
+  ASSERT_NE(running, nullptr);
+  EXPECT_EQ(running->name, "a");
+  EXPECT_EQ(book.start_next(21)->name, "a") << "one order at a time";
+  EXPECT_EQ(book.queued_count(), 1u);
+  EXPECT_TRUE(book.advance(30));
+  EXPECT_FALSE(book.advance(40));
+  EXPECT_EQ(book.find("a")->state, OrderState::finished);
+  EXPECT_EQ(book.find("a")->started, 20);
+  EXPECT_EQ(book.find("a")->finished, 40);
+  EXPECT_EQ(book.start_next(50)->name, "b");
+  book.fail_current("stalled too long", 60);
+  EXPECT_EQ(book.find("b")->state, OrderState::failed);
+  EXPECT_EQ(book.find("b")->failure, "stalled too long");
+  EXPECT_EQ(book.start_next(70), nullptr);
+  EXPECT_EQ(seen, (std::vector<std::string>{"a:queued:0", "b:queued:0", "a:running:0", "a:running:1",
+                                            "a:finished:2", "b:running:0", "b:failed:0"}));
+}
+
+TEST(OrderBook, OperationsBecomeRanActions) {
+  EXPECT_FALSE(operation_action(Destination{0, "x", "NOP", {}}));
+  EXPECT_FALSE(operation_action(Destination{0, "x", "", {}}));
+  EXPECT_FALSE(operation_action(Destination{0, "x", "park", {}}));
+  EXPECT_EQ(operation_action(Destination{0, "x", "load", {}})->kind, ran::ActionKind::load);
+  EXPECT_EQ(operation_action(Destination{0, "x", "charge", {}})->kind, ran::ActionKind::charge);
+  auto custom = operation_action(Destination{0, "x", "lift", {{"height", "1.2"}}});
+  ASSERT_TRUE(custom);
+  EXPECT_EQ(custom->kind, ran::ActionKind::custom);
+  EXPECT_EQ(custom->name, "lift");
+  EXPECT_EQ(custom->parameters.at("height"), "1.2");
+}
+
+// ---- route tracking ----
+
+TEST(RouteTracker, AllocatesWithinTheLookAheadAndMovesOnlyOntoAllocatedSteps) {
+  const auto world = h_crossing();
+  RouteTracker route = left_route(world);
+  route.mark_allocated();  // the start vertex
+  // Look-ahead of one vertex: the edge and the next vertex, then stop.
+  EXPECT_EQ(route.next_to_allocate(route.position_step(), 1), 1u);
+  route.mark_allocated();
+  EXPECT_FALSE(route.next_move()) << "the target vertex is not allocated yet";
+  EXPECT_EQ(route.next_to_allocate(route.position_step(), 1), 2u);
+  route.mark_allocated();
+  EXPECT_FALSE(route.next_to_allocate(route.position_step(), 1)) << "beyond the look-ahead";
+  ASSERT_EQ(route.next_move(), 1u);
+  const auto move = route.command_move(1, "m1", 2.0);
+  EXPECT_EQ(move.target_vertex, "left-1");
+  EXPECT_EQ(move.edge, "left-0<->left-1");
+  EXPECT_DOUBLE_EQ(move.max_speed, 1.0) << "the edge's limit";
+  ASSERT_EQ(move.area.size(), 3u);
+  EXPECT_TRUE(boost::geometry::equals(move.area[0], world->footprint(index(*world, "left-0"))));
+  EXPECT_FALSE(route.next_move());
+  EXPECT_EQ(route.position_step(), 1u) << "on the edge while the move runs";
+  route.mark_reached(2);
+  EXPECT_EQ(route.position_step(), 2u);
+  EXPECT_EQ(route.next_to_allocate(route.position_step(), 1), 3u);
+  EXPECT_FALSE(route.arrived());
+  route.mark_reached(6);
+  EXPECT_TRUE(route.arrived());
+}
+
+TEST(RouteTracker, FollowsDelaysAndMeasuresLateness) {
+  const auto world = h_crossing();
+  carp::VehicleProfile vehicle;
+  vehicle.max_speed = 1.0;
+  vehicle.acceleration = 0.5;
+  vehicle.deceleration = 0.5;
+  RouteTracker route = left_route(world);
+  // Standing at left-0 at time 0: planned at left-1 (3 m) at 3 s; the trapezoid needs 5 s.
+  auto late = route.lateness(topology::Point(0, 0), 0, vehicle, 0);
+  ASSERT_TRUE(late);
+  EXPECT_EQ(*late, seconds_to_ns(2));
+  EXPECT_DOUBLE_EQ(route.remaining_distance(topology::Point(0, 0), 6), 3 + 3 + 2.5);
+  // A delay of 4 s from step 1 on: left-1 is planned at 7 s, so the vehicle is early.
+  route.shift(1, seconds_to_ns(4));
+  EXPECT_EQ(route.step(2).window.start, seconds_to_ns(7));
+  EXPECT_EQ(route.step(6).window.end, kForever) << "open ends stay open";
+  EXPECT_EQ(*route.lateness(topology::Point(0, 0), 0, vehicle, 0), seconds_to_ns(-2));
+  // Stalled half-way at 6 s: 1.5 m from rest take sqrt(12) s.
+  EXPECT_NEAR(ns_to_seconds(*route.lateness(topology::Point(0, 1.5), 0, vehicle, seconds_to_ns(6))),
+              6 + std::sqrt(12.0) - 7, 1e-6);
+}
+
+TEST(TravelTime, TrapezoidAndTriangle) {
+  carp::VehicleProfile vehicle;
+  vehicle.max_speed = 1.0;
+  vehicle.acceleration = 0.5;
+  vehicle.deceleration = 1.0;
+  EXPECT_EQ(drive_time(0, 0, vehicle), 0);
+  // Cruise: 1 s + 2 m ramping... accel 2 s (1 m), brake 1 s (0.5 m), 8.5 m at 1 m/s.
+  EXPECT_EQ(drive_time(10, 0, vehicle), seconds_to_ns(2 + 1 + 8.5));
+  // Triangle from rest: v^2 (1/(2a) + 1/(2d)) = 0.75 -> v = sqrt(0.5).
+  EXPECT_NEAR(ns_to_seconds(drive_time(0.75, 0, vehicle)), std::sqrt(0.5) / 0.5 + std::sqrt(0.5), 1e-6);
+  // Already at speed: no acceleration phase.
+  EXPECT_EQ(drive_time(10, 1.0, vehicle), seconds_to_ns(1 + 9.5));
+  // Too short to brake in: covered while braking.
+  EXPECT_EQ(drive_time(0.25, 1.0, vehicle), seconds_to_ns(0.5));
+}
+
+// ---- footprints ----
+
+TEST(FootprintMonitor, FootprintMustStayInsideTheHeldEntities) {
+  const auto world = h_crossing();
+  FootprintMonitor monitor(world);
+  monitor.hold(index(*world, "left-0"), 0);
+  EXPECT_TRUE(monitor.inside(status_at(0, 0).footprint));
+  EXPECT_FALSE(monitor.inside(status_at(0, 1.0, 1.5707963).footprint)) << "on the edge, not held";
+  monitor.hold(index(*world, "left-0<->left-1"), 1);
+  EXPECT_TRUE(monitor.inside(status_at(0, 1.0, 1.5707963).footprint));
+  EXPECT_FALSE(monitor.inside(status_at(1.0, 1.0).footprint)) << "beside the edge";
+}
+
+TEST(FootprintMonitor, ReleasesWhatThePassedVehicleNoLongerTouches) {
+  const auto world = h_crossing();
+  FootprintMonitor monitor(world);
+  const auto start = index(*world, "left-0");
+  const auto edge = index(*world, "left-0<->left-1");
+  const auto next = index(*world, "left-1");
+  monitor.hold(start, 0);
+  monitor.hold(edge, 1);
+  monitor.hold(next, 2);
+  // Still at the start: nothing to release, the edge ahead is not passed.
+  EXPECT_TRUE(monitor.releasable(status_at(0, 0, 1.5707963).footprint, 0).empty());
+  // Leaving: the footprint still touches left-0.
+  EXPECT_TRUE(monitor.releasable(status_at(0, 0.5, 1.5707963).footprint, 0).empty());
+  // Clear of left-0, on the edge.
+  EXPECT_EQ(monitor.releasable(status_at(0, 1.5, 1.5707963).footprint, 0), std::vector{start});
+  monitor.drop(start);
+  // Arrived at left-1: the edge is passed and no longer touched.
+  EXPECT_EQ(monitor.releasable(status_at(0, 3, 1.5707963).footprint, 2), std::vector{edge});
+  // Leftovers of an earlier route count as passed.
+  monitor.hold(index(*world, "bar-1"), 9);
+  monitor.forget_steps();
+  const auto leftovers = monitor.releasable(status_at(0, 3, 1.5707963).footprint, 0);
+  EXPECT_EQ(leftovers, (std::vector{index(*world, "bar-1"), edge})) << "ascending by entity";
+}
+
+// ---- vehicle profiles ----
+
+TEST(VehicleProfileJson, ParsesAndNamesBadFields) {
+  auto vehicle = carp::parse_vehicle_profile(R"({"id": "V1", "max_speed": 1.5, "acceleration": 0.5})", "v.json");
+  ASSERT_TRUE(vehicle);
+  EXPECT_EQ(vehicle->id, "V1");
+  EXPECT_DOUBLE_EQ(vehicle->max_speed, 1.5);
+  EXPECT_DOUBLE_EQ(vehicle->acceleration, 0.5);
+  auto unknown = carp::parse_vehicle_profile(R"({"speed": 1})", "v.json");
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().message.find("v.json: speed: unknown field"), std::string::npos);
+  auto wrong = carp::parse_vehicle_profile(R"({"max_speed": "fast"})", "v.json");
+  ASSERT_FALSE(wrong);
+  EXPECT_EQ(wrong.error().code, ErrorCode::parse);
+  auto range = carp::parse_vehicle_profile(R"({"max_speed": -1})", "v.json");
+  ASSERT_FALSE(range);
+  EXPECT_EQ(range.error().code, ErrorCode::invalid_argument);
+  EXPECT_FALSE(carp::parse_vehicle_profile("{", "v.json"));
+  EXPECT_EQ(carp::read_vehicle_profile("/nonexistent/v.json").error().code, ErrorCode::io);
+}
+
+}  // namespace
+}  // namespace drover::logical_agent
