@@ -28,4 +28,10 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context);
 /// `drover ran-sim ...`: a simulated vehicle as a RAN process (agents/ran_runner/cli/).
 void add_ran_commands(CLI::App& app, CommandContext& context);
 
+/// `drover launch FILE`: starts and supervises the agents of a launch file (agents/launcher/).
+void add_launch_command(CLI::App& app, CommandContext& context);
+
+/// `drover load-generator`: random orders between stations to idle vehicles (agents/launcher/).
+void add_load_generator_command(CLI::App& app, CommandContext& context);
+
 }  // namespace drover::cli

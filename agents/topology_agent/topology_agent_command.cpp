@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "agents/cli/clock_options.hpp"
 #include "agents/cli/command.hpp"
 #include "agents/topology_agent/topology_agent.hpp"
 #include "drover/common/clock.hpp"
@@ -24,8 +25,7 @@ struct TopologyAgentArguments {
   std::uint32_t domain_id = 0;
   std::string agent_id;
   std::string xml_profile;
-  double time_factor = 1.0;
-  std::optional<TimeNs> epoch_ns;
+  ClockArguments clock;
   std::string log_level = "info";
 };
 
@@ -42,12 +42,9 @@ int run(const TopologyAgentArguments& arguments) {
     }
     return kExitBadInput;
   }
-  auto clock = arguments.epoch_ns || arguments.time_factor != 1.0
-                   ? SharedClock::create(arguments.epoch_ns.value_or(SharedClock::wall().now()),
-                                         arguments.time_factor)
-                   : Result<SharedClock>(SharedClock::wall());
+  auto clock = make_clock(arguments.clock);
   if (!clock) {
-    std::cerr << "error: --time-factor: " << clock.error().message << "\n";
+    std::cerr << "error: " << clock.error().message << "\n";
     return kExitBadInput;
   }
   if (auto installed = dds::install_shutdown_handlers(); !installed) {
@@ -95,9 +92,7 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
                       "Agent id (default: topology-<partition>, or topology)");
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
-  command->add_option("--time-factor", arguments->time_factor,
-                      "Shared-clock seconds per real second (default 1)");
-  command->add_option("--epoch-ns", arguments->epoch_ns, "Shared-clock time at start, ns (default: Unix time now)");
+  add_clock_options(*command, arguments->clock);
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });

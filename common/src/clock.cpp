@@ -13,10 +13,24 @@ Result<SharedClock> SharedClock::create(TimeNs epoch_ns, double factor) {
   return SharedClock(epoch_ns, factor, std::chrono::steady_clock::now());
 }
 
+Result<SharedClock> SharedClock::create_at_origin(TimeNs epoch_ns, double factor,
+                                                  TimeNs origin_unix_ns) {
+  auto clock = create(epoch_ns, factor);
+  if (!clock) return clock;
+  // The steady-clock instant at which the clock read epoch_ns: as long before now as the
+  // origin lies before the Unix time now (after it, for an origin in the future).
+  const auto since_origin = std::chrono::nanoseconds(unix_now() - origin_unix_ns);
+  return SharedClock(epoch_ns, factor, std::chrono::steady_clock::now() - since_origin);
+}
+
 SharedClock SharedClock::wall() {
-  const auto unix_now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-      std::chrono::system_clock::now().time_since_epoch());
-  return SharedClock(unix_now.count(), 1.0, std::chrono::steady_clock::now());
+  return SharedClock(unix_now(), 1.0, std::chrono::steady_clock::now());
+}
+
+TimeNs SharedClock::unix_now() noexcept {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 TimeNs SharedClock::now() const noexcept {

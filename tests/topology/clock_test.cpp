@@ -30,6 +30,19 @@ TEST(SharedClock, NeverGoesBackwards) {
   }
 }
 
+TEST(SharedClock, ClocksCreatedLaterFromOneOriginAgree) {
+  // Two processes started at different real times, given the same epoch, factor and
+  // origin: the later one must not lag behind by (its start delay) x factor.
+  const TimeNs origin = SharedClock::unix_now() - 2 * kNsPerSecond;  // started 2 s ago
+  auto clock = SharedClock::create_at_origin(100 * kNsPerSecond, 50.0, origin);
+  ASSERT_TRUE(clock.has_value());
+  // 2 real seconds at factor 50 have passed: 100 s of shared-clock time, give or take
+  // the time this test takes to get here (bounded generously, never slept).
+  EXPECT_GE(clock->now(), 200 * kNsPerSecond);
+  EXPECT_LT(clock->now(), 300 * kNsPerSecond);
+  EXPECT_FALSE(SharedClock::create_at_origin(0, 0.0, origin).has_value());
+}
+
 TEST(Seconds, RoundTripsThroughNanoseconds) {
   EXPECT_EQ(seconds_to_ns(1.5), 1'500'000'000);
   EXPECT_EQ(seconds_to_ns(-0.25), -250'000'000);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "agents/cli/clock_options.hpp"
 #include "agents/cli/command.hpp"
 #include "drover/common/clock.hpp"
 #include "drover/common/logging.hpp"
@@ -35,8 +36,7 @@ struct RanSimArguments {
   std::uint32_t domain_id = 0;
   std::string agent_id;
   std::string xml_profile;
-  double time_factor = 1.0;
-  std::optional<TimeNs> epoch_ns;
+  ClockArguments clock;
   int status_period_ms = 100;
   std::string log_level = "info";
   ran::SimVehicleConfig vehicle;
@@ -97,11 +97,8 @@ int run(RanSimArguments arguments) {
     config.custom_actions[entry.substr(0, equals)] = seconds_to_ns(seconds);
   }
 
-  auto clock = arguments.epoch_ns || arguments.time_factor != 1.0
-                   ? SharedClock::create(arguments.epoch_ns.value_or(SharedClock::wall().now()),
-                                         arguments.time_factor)
-                   : Result<SharedClock>(SharedClock::wall());
-  if (!clock) return fail_input("--time-factor: " + clock.error().message);
+  auto clock = make_clock(arguments.clock);
+  if (!clock) return fail_input(clock.error().message);
 
   auto vehicle = ran::SimVehicle::create(config, start, clock->now(), world);
   if (!vehicle) return fail_input(vehicle.error().message);
@@ -156,10 +153,7 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)");
   sim->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
-  sim->add_option("--time-factor", arguments->time_factor,
-                  "Shared-clock seconds per real second (default 1)");
-  sim->add_option("--epoch", arguments->epoch_ns,
-                  "Shared-clock time at start, ns (default: Unix time now)");
+  add_clock_options(*sim, arguments->clock);
   sim->add_option("--status-period-ms", arguments->status_period_ms,
                   "Real milliseconds between status reports (default 100)")
       ->check(CLI::Range(1, 60000));

@@ -37,8 +37,19 @@ class SharedClock {
   /// \return the clock, or invalid_argument when factor is not positive and finite.
   static Result<SharedClock> create(TimeNs epoch_ns, double factor);
 
+  /// A clock that read `epoch_ns` at the real Unix time `origin_unix_ns` (ns since 1970)
+  /// and runs `factor` times faster since. Processes given the same three values agree on
+  /// the time however late each of them starts (up to their hosts' system clocks): this is
+  /// how the launcher gives every agent one clock. The system clock is read once, here;
+  /// afterwards the clock follows the steady clock, so it never jumps.
+  /// \return the clock, or invalid_argument when factor is not positive and finite.
+  static Result<SharedClock> create_at_origin(TimeNs epoch_ns, double factor, TimeNs origin_unix_ns);
+
   /// A clock with epoch = the Unix time now and factor 1 (a plant).
   static SharedClock wall();
+
+  /// The Unix time now, in nanoseconds (the system clock).
+  static TimeNs unix_now() noexcept;
 
   /// Current shared-clock time in nanoseconds (monotonic: never goes backwards).
   TimeNs now() const noexcept;

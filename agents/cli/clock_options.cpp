@@ -1,0 +1,26 @@
+#include "agents/cli/clock_options.hpp"
+
+namespace drover::cli {
+
+void add_clock_options(CLI::App& command, ClockArguments& arguments) {
+  command.add_option("--time-factor", arguments.time_factor,
+                     "Shared-clock seconds per real second (default 1)");
+  command.add_option("--epoch,--epoch-ns", arguments.epoch_ns,
+                     "Shared-clock time at the clock origin, ns (default: the Unix time then)");
+  command.add_option("--clock-origin", arguments.origin_unix_ns,
+                     "Unix time, ns, at which the clock read --epoch (default: this process's "
+                     "start); the launcher gives every agent the same one");
+}
+
+Result<SharedClock> make_clock(const ClockArguments& arguments) {
+  if (!arguments.epoch_ns && !arguments.origin_unix_ns && arguments.time_factor == 1.0) {
+    return SharedClock::wall();
+  }
+  const TimeNs origin = arguments.origin_unix_ns.value_or(SharedClock::unix_now());
+  auto clock = SharedClock::create_at_origin(arguments.epoch_ns.value_or(origin),
+                                             arguments.time_factor, origin);
+  if (!clock) return fail(ErrorCode::invalid_argument, "--time-factor: " + clock.error().message);
+  return clock;
+}
+
+}  // namespace drover::cli

@@ -1,0 +1,41 @@
+#pragma once
+// Counts the orders of a run from their progress (drover/logical/order_progress): how many
+// finished and failed, and their mean lead time (finished - created on the shared clock).
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "drover/common/clock.hpp"
+
+namespace drover::launcher {
+
+enum class OrderOutcome { open, finished, failed };
+
+struct OrderFigures {
+  std::uint64_t open = 0;
+  std::uint64_t finished = 0;
+  std::uint64_t failed = 0;
+  /// Mean of finished - created over the finished orders that carry both times.
+  std::optional<double> mean_lead_time_s;
+};
+
+/// Not thread-safe; the monitor guards it.
+class OrderTally {
+ public:
+  /// Records the latest progress of `order`. An order that ended stays ended (a late
+  /// duplicate of an earlier state does not reopen it).
+  void update(const std::string& order, OrderOutcome outcome, std::optional<TimeNs> created,
+              std::optional<TimeNs> finished);
+  OrderFigures figures() const;
+
+ private:
+  struct Entry {
+    OrderOutcome outcome = OrderOutcome::open;
+    std::optional<DurationNs> lead_time;
+  };
+  std::map<std::string, Entry> orders_;
+};
+
+}  // namespace drover::launcher

@@ -1,0 +1,37 @@
+#pragma once
+// Starting an agent as a child process whose stdout and stderr come back through pipes.
+
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+#include "drover/common/result.hpp"
+
+namespace drover::launcher {
+
+/// A started child: its pid and the read ends of its stdout and stderr pipes (non-blocking,
+/// close-on-exec; the caller closes them once it has read them to the end).
+struct SpawnedProcess {
+  pid_t pid = -1;
+  int stdout_fd = -1;
+  int stderr_fd = -1;
+};
+
+/// Starts `executable` with `arguments` (argv[1..]) by fork and exec. The child gets an
+/// empty signal mask, its own process group (a Ctrl-C on the terminal reaches only the
+/// launcher, which stops its agents in order) and SIGTERM when the launcher dies, so no
+/// agent outlives it; it inherits no other descriptor than the pipes and stdin.
+/// \return the child, or io when pipes or fork fail. A failed exec shows as the child
+/// writing the reason to its stderr and exiting with 127.
+Result<SpawnedProcess> spawn_process(const std::string& executable,
+                                     const std::vector<std::string>& arguments);
+
+/// The path of the running executable (/proc/self/exe resolved), for starting agents with
+/// the same `drover` binary. \return the path, or io.
+Result<std::string> current_executable();
+
+/// "exited with code N" or "killed by signal N (NAME)", for a waitpid() status.
+std::string describe_wait_status(int status);
+
+}  // namespace drover::launcher

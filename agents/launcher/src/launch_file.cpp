@@ -1,0 +1,535 @@
+#include "drover/launcher/launch_file.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "drover/dds/participant.hpp"
+#include "drover/topology/topology_file.hpp"
+
+namespace drover::launcher {
+
+namespace {
+
+using Json = nlohmann::json;
+
+/// What a field's value must be, and how it becomes a command-line value.
+enum class FieldType {
+  text,             ///< a non-empty string
+  vertex,           ///< the id of a vertex of the topology
+  vertex_list,      ///< a non-empty array of vertex ids (one option per id)
+  partition,        ///< a partition named by the topology
+  number,           ///< a finite number
+  positive_number,  ///< a finite number > 0
+  count,            ///< an integer >= 0
+  flag,             ///< true adds the option without a value; false leaves it out
+  journal,          ///< a file path; relative ones are relative to the state directory
+};
+
+struct FieldRule {
+  std::string_view key;
+  std::string_view option;  ///< the subcommand's option it becomes
+  FieldType type;
+};
+
+/// The fields a vehicle profile may set, and the ran-sim options they become.
+const std::vector<FieldRule> kProfileFields{
+    {"max_speed", "--max-speed", FieldType::positive_number},
+    {"acceleration", "--acceleration", FieldType::positive_number},
+    {"deceleration", "--deceleration", FieldType::positive_number},
+    {"angular_speed", "--angular-speed", FieldType::positive_number},
+    {"battery_capacity", "--battery-capacity", FieldType::positive_number},
+    {"battery", "--battery", FieldType::number},
+    {"drain", "--drain", FieldType::number},
+    {"charge_rate", "--charge-rate", FieldType::number},
+    {"load_duration", "--load-duration", FieldType::number},
+    {"unload_duration", "--unload-duration", FieldType::number},
+};
+
+struct KindRules {
+  AgentKind kind;
+  std::string_view name;
+  std::string_view subcommand;
+  std::string_view id_option;       ///< the option that sets the agent id
+  std::string_view vehicle_option;  ///< the option that sets the vehicle id; empty: none
+  bool takes_profile;               ///< ran-sim: a vehicle profile's fields become options
+  bool takes_topology;              ///< gets --topology FILE
+  std::vector<FieldRule> fields;    ///< besides kind, id, vehicle, restart, max_restarts
+};
+
+const std::vector<KindRules>& kind_rules() {
+  static const std::vector<KindRules> rules{
+      {AgentKind::topology, "topology", "topology-agent", "--id", "", false, true,
+       {{"partition", "--partition", FieldType::partition},
+        {"db", "--db", FieldType::journal},
+        {"log_level", "--log-level", FieldType::text}}},
+      {AgentKind::ran_sim, "ran-sim", "ran-sim", "--agent-id", "--id", true, true,
+       {{"at", "--at", FieldType::vertex},
+        {"heading", "--heading", FieldType::number},
+        {"loaded", "--loaded", FieldType::flag},
+        {"status_period_ms", "--status-period-ms", FieldType::count},
+        {"log_level", "--log-level", FieldType::text}}},
+      {AgentKind::routing, "routing", "routing-agent", "--id", "", false, false,
+       {{"log_level", "--log-level", FieldType::text}}},
+      {AgentKind::logical, "logical", "logical-agent", "--id", "", false, false,
+       {{"log_level", "--log-level", FieldType::text}}},
+      {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
+       {{"seed", "--seed", FieldType::count},
+        {"stations", "--station", FieldType::vertex_list},
+        {"max_orders", "--max-orders", FieldType::count},
+        {"log_level", "--log-level", FieldType::text}}},
+  };
+  return rules;
+}
+
+const KindRules* find_kind(std::string_view name) {
+  for (const auto& rules : kind_rules()) {
+    if (rules.name == name) return &rules;
+  }
+  return nullptr;
+}
+
+const KindRules& rules_of(AgentKind kind) {
+  for (const auto& rules : kind_rules()) {
+    if (rules.kind == kind) return rules;
+  }
+  return kind_rules().front();  // unreachable: every kind has rules
+}
+
+std::string kind_list() {
+  std::string list;
+  for (const auto& rules : kind_rules()) list += (list.empty() ? "" : ", ") + std::string(rules.name);
+  return list;
+}
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out.precision(17);
+  out << value;
+  return out.str();
+}
+
+/// Collects the problems of one launch file while it is checked.
+class Checker {
+ public:
+  void problem(std::string where, std::string what) {
+    problems_.push_back({std::move(where), std::move(what)});
+  }
+  LaunchProblems take() { return std::move(problems_); }
+  bool clean() const { return problems_.empty(); }
+
+ private:
+  LaunchProblems problems_;
+};
+
+class LaunchFileParser {
+ public:
+  LaunchFileParser(const std::filesystem::path& path, const std::filesystem::path& state_dir)
+      : state_dir_(state_dir) {
+    file_.path = path;
+  }
+
+  Result<LaunchFile, LaunchProblems> parse(std::string_view text) {
+    Json root;
+    try {
+      root = Json::parse(text);
+    } catch (const Json::parse_error& error) {
+      checker_.problem("", std::string("not valid JSON: ") + error.what());
+      return unexpected(checker_.take());
+    }
+    if (!root.is_object()) {
+      checker_.problem("", "the launch file must be a JSON object");
+      return unexpected(checker_.take());
+    }
+    reject_unknown_keys(root, "", {"name", "domain", "time_factor", "epoch", "topology",
+                                   "vehicle_profiles", "agents"});
+    read_header(root);
+    read_profiles(root);
+    if (const auto agents = root.find("agents"); agents == root.end()) {
+      checker_.problem("agents", "missing: the list of agents to start");
+    } else if (!agents->is_array() || agents->empty()) {
+      checker_.problem("agents", "must be a non-empty array of agent entries");
+    } else {
+      for (std::size_t index = 0; index < agents->size(); ++index) {
+        read_agent((*agents)[index], "agents[" + std::to_string(index) + "]");
+      }
+      check_fleet();
+    }
+    if (!checker_.clean()) return unexpected(checker_.take());
+    return std::move(file_);
+  }
+
+ private:
+  void reject_unknown_keys(const Json& object, const std::string& where,
+                           std::initializer_list<std::string_view> known) {
+    for (const auto& [key, value] : object.items()) {
+      bool found = false;
+      for (auto name : known) found = found || name == key;
+      if (!found) checker_.problem(join(where, key), "unknown field");
+    }
+  }
+
+  static std::string join(const std::string& where, std::string_view key) {
+    return where.empty() ? std::string(key) : where + "." + std::string(key);
+  }
+
+  void read_header(const Json& root) {
+    if (auto name = root.find("name"); name != root.end()) {
+      if (name->is_string()) file_.name = name->get<std::string>();
+      else checker_.problem("name", "must be a string");
+    }
+    if (auto domain = root.find("domain"); domain != root.end()) {
+      if (domain->is_number_integer() && domain->get<std::int64_t>() >= 0 &&
+          domain->get<std::int64_t>() <= 232) {
+        file_.domain_id = domain->get<std::uint32_t>();
+      } else {
+        checker_.problem("domain", "must be an integer DDS domain id in 0..232");
+      }
+    }
+    if (auto factor = root.find("time_factor"); factor != root.end()) {
+      if (factor->is_number() && std::isfinite(factor->get<double>()) && factor->get<double>() > 0) {
+        file_.time_factor = factor->get<double>();
+      } else {
+        checker_.problem("time_factor", "must be a positive number (shared-clock seconds per real second)");
+      }
+    }
+    if (auto epoch = root.find("epoch"); epoch != root.end()) {
+      if (epoch->is_number_integer()) {
+        file_.epoch_ns = epoch->get<TimeNs>();
+      } else if (!(epoch->is_string() && epoch->get<std::string>() == "now")) {
+        checker_.problem("epoch", "must be \"now\" or an integer (shared-clock nanoseconds at start)");
+      }
+    }
+    const auto topology = root.find("topology");
+    if (topology == root.end() || !topology->is_string() || topology->get<std::string>().empty()) {
+      checker_.problem("topology", "missing or not a string: the topology file (relative to the launch file)");
+      return;
+    }
+    std::filesystem::path topology_path = topology->get<std::string>();
+    if (topology_path.is_relative()) topology_path = file_.path.parent_path() / topology_path;
+    file_.topology_file = std::filesystem::absolute(topology_path).lexically_normal();
+    auto loaded = topology::load_topology_file(file_.topology_file);
+    if (!loaded) {
+      for (const auto& problem : loaded.error()) {
+        checker_.problem("topology", file_.topology_file.string() +
+                                         (problem.where.empty() ? "" : ": " + problem.where) +
+                                         ": " + problem.what);
+      }
+      return;
+    }
+    topology_ = std::move(*loaded);
+  }
+
+  void read_profiles(const Json& root) {
+    const auto profiles = root.find("vehicle_profiles");
+    if (profiles == root.end()) return;
+    if (!profiles->is_object()) {
+      checker_.problem("vehicle_profiles", "must be an object of named profiles");
+      return;
+    }
+    for (const auto& [name, profile] : profiles->items()) {
+      const std::string where = "vehicle_profiles." + name;
+      if (!profile.is_object()) {
+        checker_.problem(where, "must be an object");
+        continue;
+      }
+      std::vector<std::string> options;
+      for (const auto& [key, value] : profile.items()) {
+        const FieldRule* rule = nullptr;
+        for (const auto& candidate : kProfileFields) {
+          if (candidate.key == key) rule = &candidate;
+        }
+        if (rule == nullptr) {
+          checker_.problem(join(where, key), "unknown field (expected one of: " + profile_field_list() + ")");
+          continue;
+        }
+        add_option(*rule, value, join(where, key), options);
+      }
+      profiles_[name] = std::move(options);
+    }
+  }
+
+  static std::string profile_field_list() {
+    std::string list;
+    for (const auto& rule : kProfileFields) list += (list.empty() ? "" : ", ") + std::string(rule.key);
+    return list;
+  }
+
+  void read_agent(const Json& entry, const std::string& where) {
+    if (!entry.is_object()) {
+      checker_.problem(where, "must be an object");
+      return;
+    }
+    const auto kind = entry.find("kind");
+    if (kind == entry.end() || !kind->is_string()) {
+      checker_.problem(join(where, "kind"), "missing: one of " + kind_list());
+      return;
+    }
+    const KindRules* rules = find_kind(kind->get<std::string>());
+    if (rules == nullptr) {
+      checker_.problem(join(where, "kind"), "unknown kind '" + kind->get<std::string>() +
+                                                "' (expected one of " + kind_list() + ")");
+      return;
+    }
+    AgentEntry agent;
+    agent.kind = rules->kind;
+    const bool has_vehicle = rules->kind == AgentKind::ran_sim || rules->kind == AgentKind::logical;
+    for (const auto& [key, value] : entry.items()) {
+      const std::string field = join(where, key);
+      if (key == "kind") continue;
+      if (key == "id" || (key == "vehicle" && has_vehicle)) {
+        if (!value.is_string() || value.get<std::string>().empty()) {
+          checker_.problem(field, "must be a non-empty string");
+        } else {
+          (key == "id" ? agent.id : agent.vehicle) = value.get<std::string>();
+        }
+      } else if (key == "restart") {
+        if (value == "never") agent.restart = RestartPolicy::never;
+        else if (value == "on-failure") agent.restart = RestartPolicy::on_failure;
+        else checker_.problem(field, "must be \"never\" or \"on-failure\"");
+      } else if (key == "max_restarts") {
+        if (value.is_number_integer() && value.get<std::int64_t>() >= 0 && value.get<std::int64_t>() <= 1000) {
+          agent.max_restarts = value.get<int>();
+        } else {
+          checker_.problem(field, "must be an integer in 0..1000");
+        }
+      } else if (key == "profile" && rules->takes_profile) {
+        const auto profile = value.is_string() ? profiles_.find(value.get<std::string>()) : profiles_.end();
+        if (profile == profiles_.end()) {
+          checker_.problem(field, "names no entry of vehicle_profiles");
+        } else {
+          agent.options.insert(agent.options.end(), profile->second.begin(), profile->second.end());
+        }
+      } else {
+        const FieldRule* rule = nullptr;
+        for (const auto& candidate : rules->fields) {
+          if (candidate.key == key) rule = &candidate;
+        }
+        if (rule == nullptr) {
+          checker_.problem(field, "unknown field for kind '" + std::string(rules->name) + "'");
+        } else {
+          add_option(*rule, value, field, agent.options);
+        }
+      }
+    }
+    if (has_vehicle && agent.vehicle.empty()) {
+      checker_.problem(join(where, "vehicle"), "missing: the vehicle id");
+    }
+    if (rules->kind == AgentKind::ran_sim && !entry.contains("at")) {
+      checker_.problem(join(where, "at"), "missing: the vertex the vehicle starts at");
+    }
+    if (rules->kind == AgentKind::logical && !agent.id.empty() && agent.id != agent.vehicle) {
+      checker_.problem(join(where, "id"), "a logical agent's id is its vehicle id: leave it out");
+    }
+    if (agent.id.empty()) agent.id = default_id(*rules, agent, entry);
+    if (auto valid = dds::validate_agent_id(agent.id); !valid) {
+      checker_.problem(join(where, "id"), valid.error().message);
+    }
+    // Identity and topology first, then the entry's own options.
+    std::vector<std::string> identity{std::string(rules->id_option), agent.id};
+    if (!rules->vehicle_option.empty()) {
+      identity.insert(identity.end(), {std::string(rules->vehicle_option), agent.vehicle});
+    }
+    if (rules->takes_topology) identity.insert(identity.end(), {"--topology", file_.topology_file.string()});
+    agent.options.insert(agent.options.begin(), identity.begin(), identity.end());
+    starts_.push_back(entry.contains("at") && entry["at"].is_string() ? entry["at"].get<std::string>() : "");
+    wheres_.push_back(where);
+    partitions_.push_back(entry.contains("partition") && entry["partition"].is_string()
+                              ? entry["partition"].get<std::string>()
+                              : "");
+    file_.agents.push_back(std::move(agent));
+  }
+
+  static std::string default_id(const KindRules& rules, const AgentEntry& agent, const Json& entry) {
+    switch (rules.kind) {
+      case AgentKind::topology:
+        return entry.contains("partition") && entry["partition"].is_string()
+                   ? "topology-" + entry["partition"].get<std::string>()
+                   : "topology";
+      case AgentKind::ran_sim: return "ran-" + agent.vehicle;
+      case AgentKind::logical: return agent.vehicle;
+      case AgentKind::routing: return "routing";
+      case AgentKind::load_generator: return "load-generator";
+    }
+    return "agent";
+  }
+
+  void add_option(const FieldRule& rule, const Json& value, const std::string& where,
+                  std::vector<std::string>& options) {
+    const std::string option(rule.option);
+    switch (rule.type) {
+      case FieldType::text:
+        if (!value.is_string() || value.get<std::string>().empty()) {
+          return checker_.problem(where, "must be a non-empty string");
+        }
+        options.insert(options.end(), {option, value.get<std::string>()});
+        return;
+      case FieldType::vertex:
+        if (!value.is_string()) return checker_.problem(where, "must be a vertex id (a string)");
+        if (check_vertex(value.get<std::string>(), where)) {
+          options.insert(options.end(), {option, value.get<std::string>()});
+        }
+        return;
+      case FieldType::vertex_list:
+        if (!value.is_array() || value.empty()) {
+          return checker_.problem(where, "must be a non-empty array of vertex ids");
+        }
+        for (std::size_t index = 0; index < value.size(); ++index) {
+          const std::string item_where = where + "[" + std::to_string(index) + "]";
+          if (!value[index].is_string()) {
+            checker_.problem(item_where, "must be a vertex id (a string)");
+          } else if (check_vertex(value[index].get<std::string>(), item_where)) {
+            options.insert(options.end(), {option, value[index].get<std::string>()});
+          }
+        }
+        return;
+      case FieldType::partition: {
+        if (!value.is_string()) return checker_.problem(where, "must be a partition name (a string)");
+        if (!topology_) return;  // the topology's own problems are reported already
+        const auto partitions = topology_->partitions();
+        if (std::find(partitions.begin(), partitions.end(), value.get<std::string>()) == partitions.end()) {
+          std::string list;
+          for (const auto& name : partitions) list += (list.empty() ? "" : ", ") + name;
+          return checker_.problem(where, "the topology has no partition '" + value.get<std::string>() +
+                                             "' (it has: " + (list.empty() ? "none" : list) + ")");
+        }
+        options.insert(options.end(), {option, value.get<std::string>()});
+        return;
+      }
+      case FieldType::number:
+      case FieldType::positive_number:
+        if (!value.is_number() || !std::isfinite(value.get<double>()) ||
+            (rule.type == FieldType::positive_number && value.get<double>() <= 0)) {
+          return checker_.problem(where, rule.type == FieldType::number ? "must be a number"
+                                                                        : "must be a number > 0");
+        }
+        options.insert(options.end(), {option, format_number(value.get<double>())});
+        return;
+      case FieldType::count:
+        if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+          return checker_.problem(where, "must be an integer >= 0");
+        }
+        options.insert(options.end(), {option, std::to_string(value.get<std::int64_t>())});
+        return;
+      case FieldType::flag:
+        if (!value.is_boolean()) return checker_.problem(where, "must be true or false");
+        if (value.get<bool>()) options.push_back(option);
+        return;
+      case FieldType::journal: {
+        if (!value.is_string() || value.get<std::string>().empty()) {
+          return checker_.problem(where, "must be a file path (relative: in the state directory)");
+        }
+        std::filesystem::path journal = value.get<std::string>();
+        if (journal.is_relative()) journal = state_dir_ / journal;
+        options.insert(options.end(), {option, journal.lexically_normal().string()});
+        return;
+      }
+    }
+  }
+
+  bool check_vertex(const std::string& id, const std::string& where) {
+    if (!topology_) return false;
+    const auto entity = topology_->find(id);
+    if (!entity || !topology_->is_vertex(*entity)) {
+      checker_.problem(where, "'" + id + "' is not a vertex of " + file_.topology_file.string());
+      return false;
+    }
+    return true;
+  }
+
+  /// Checks across entries: unique ids, one RAN per vehicle, start vertices apart,
+  /// topology agents covering every partition once.
+  void check_fleet() {
+    std::map<std::string, std::size_t> ids;
+    std::map<std::string, std::size_t> ran_vehicles;
+    std::map<std::string, std::size_t> partition_owner;
+    std::map<topology::EntityIndex, std::size_t> start_owner;
+    bool whole_topology_served = false;
+    bool any_topology_agent = false;
+    for (std::size_t index = 0; index < file_.agents.size(); ++index) {
+      const auto& agent = file_.agents[index];
+      const std::string& where = wheres_[index];
+      if (auto [it, inserted] = ids.emplace(agent.id, index); !inserted) {
+        checker_.problem(where + ".id", "agent id '" + agent.id + "' is used by " + wheres_[it->second] +
+                                            " too (ids must be unique; set \"id\")");
+      }
+      if (agent.kind == AgentKind::ran_sim) {
+        if (auto [it, inserted] = ran_vehicles.emplace(agent.vehicle, index); !inserted) {
+          checker_.problem(where + ".vehicle", "vehicle '" + agent.vehicle + "' has a ran-sim at " +
+                                                   wheres_[it->second] + " already");
+        }
+        check_start(index, start_owner);
+      }
+      if (agent.kind == AgentKind::topology) {
+        any_topology_agent = true;
+        if (partitions_[index].empty()) {
+          whole_topology_served = true;
+        } else if (auto [it, inserted] = partition_owner.emplace(partitions_[index], index); !inserted) {
+          checker_.problem(where + ".partition", "partition '" + partitions_[index] + "' is served by " +
+                                                     wheres_[it->second] + " already");
+        }
+      }
+    }
+    if (topology_ && any_topology_agent && !whole_topology_served) {
+      for (const auto& partition : topology_->partitions()) {
+        if (!partition_owner.contains(partition)) {
+          checker_.problem("agents", "no topology agent serves partition '" + partition + "'");
+        }
+      }
+    }
+  }
+
+  /// Two simulated vehicles must not start on one vertex or on conflicting ones (their
+  /// footprints would overlap from the first instant).
+  void check_start(std::size_t index, std::map<topology::EntityIndex, std::size_t>& start_owner) {
+    if (!topology_ || starts_[index].empty()) return;
+    const auto vertex = topology_->find(starts_[index]);
+    if (!vertex || !topology_->is_vertex(*vertex)) return;  // reported already
+    auto clash = start_owner.find(*vertex);
+    for (auto other : topology_->conflicts(*vertex)) {
+      if (clash == start_owner.end()) clash = start_owner.find(other);
+    }
+    if (clash != start_owner.end()) {
+      checker_.problem(wheres_[index] + ".at", "'" + starts_[index] + "' is, or conflicts with, the start of " +
+                                                   wheres_[clash->second]);
+      return;
+    }
+    start_owner.emplace(*vertex, index);
+  }
+
+  std::filesystem::path state_dir_;
+  LaunchFile file_;
+  Checker checker_;
+  std::optional<topology::Topology> topology_;
+  std::map<std::string, std::vector<std::string>> profiles_;
+  // Per agent entry, parallel to file_.agents: its start vertex, its place, its partition.
+  std::vector<std::string> starts_;
+  std::vector<std::string> wheres_;
+  std::vector<std::string> partitions_;
+};
+
+}  // namespace
+
+std::string_view kind_name(AgentKind kind) noexcept { return rules_of(kind).name; }
+std::string_view subcommand(AgentKind kind) noexcept { return rules_of(kind).subcommand; }
+
+Result<LaunchFile, LaunchProblems> parse_launch_file(std::string_view text,
+                                                     const std::filesystem::path& path,
+                                                     const std::filesystem::path& state_dir) {
+  return LaunchFileParser(path, state_dir).parse(text);
+}
+
+Result<LaunchFile, LaunchProblems> load_launch_file(const std::filesystem::path& path,
+                                                    const std::filesystem::path& state_dir) {
+  std::ifstream in(path);
+  if (!in) return unexpected(LaunchProblems{{"", "cannot read the file"}});
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_launch_file(text.str(), path, state_dir);
+}
+
+}  // namespace drover::launcher

@@ -1,0 +1,101 @@
+#include "drover/launcher/process.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstring>
+#include <filesystem>
+
+namespace drover::launcher {
+
+namespace {
+
+void close_pair(int fds[2]) {
+  if (fds[0] >= 0) ::close(fds[0]);
+  if (fds[1] >= 0) ::close(fds[1]);
+}
+
+/// In the child between fork and exec: only async-signal-safe calls.
+[[noreturn]] void exec_child(pid_t parent, const char* executable, char* const* argv, int out_fd,
+                             int err_fd) {
+  sigset_t none;
+  sigemptyset(&none);
+  sigprocmask(SIG_SETMASK, &none, nullptr);
+  setpgid(0, 0);
+  prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (getppid() != parent) _exit(1);  // the launcher died before prctl took effect
+  dup2(out_fd, STDOUT_FILENO);
+  dup2(err_fd, STDERR_FILENO);
+  close_range(3, UINT_MAX, 0);
+  execv(executable, argv);
+  const char* reason = strerror(errno);
+  const char prefix[] = "error: cannot execute ";
+  (void)!write(STDERR_FILENO, prefix, sizeof prefix - 1);
+  (void)!write(STDERR_FILENO, executable, strlen(executable));
+  (void)!write(STDERR_FILENO, ": ", 2);
+  (void)!write(STDERR_FILENO, reason, strlen(reason));
+  (void)!write(STDERR_FILENO, "\n", 1);
+  _exit(127);
+}
+
+}  // namespace
+
+Result<SpawnedProcess> spawn_process(const std::string& executable,
+                                     const std::vector<std::string>& arguments) {
+  // argv is built before fork: the child may not allocate.
+  std::vector<std::string> storage;
+  storage.reserve(arguments.size() + 1);
+  storage.push_back(executable);
+  storage.insert(storage.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (auto& argument : storage) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+
+  int out[2] = {-1, -1};
+  int err[2] = {-1, -1};
+  if (::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(err, O_CLOEXEC) != 0) {
+    const std::string reason = std::strerror(errno);
+    close_pair(out);
+    close_pair(err);
+    return fail(ErrorCode::io, "cannot create pipes for " + executable + ": " + reason);
+  }
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const std::string reason = std::strerror(errno);
+    close_pair(out);
+    close_pair(err);
+    return fail(ErrorCode::io, "cannot fork to start " + executable + ": " + reason);
+  }
+  if (pid == 0) exec_child(parent, storage.front().c_str(), argv.data(), out[1], err[1]);
+  ::close(out[1]);
+  ::close(err[1]);
+  ::fcntl(out[0], F_SETFL, O_NONBLOCK);
+  ::fcntl(err[0], F_SETFL, O_NONBLOCK);
+  return SpawnedProcess{pid, out[0], err[0]};
+}
+
+Result<std::string> current_executable() {
+  std::error_code error;
+  auto path = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return fail(ErrorCode::io, "cannot resolve /proc/self/exe: " + error.message());
+  return path.string();
+}
+
+std::string describe_wait_status(int status) {
+  if (WIFEXITED(status)) return "exited with code " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) {
+    const int signal_number = WTERMSIG(status);
+    const char* name = sigabbrev_np(signal_number);
+    return "killed by signal " + std::to_string(signal_number) +
+           (name != nullptr ? std::string(" (SIG") + name + ")" : std::string());
+  }
+  return "ended (status " + std::to_string(status) + ")";
+}
+
+}  // namespace drover::launcher
