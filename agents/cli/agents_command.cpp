@@ -16,6 +16,7 @@
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "drover/dds/agent_directory.hpp"
+#include "drover/dds/participant.hpp"
 
 namespace drover::cli {
 namespace {
@@ -118,10 +119,20 @@ int run_agents(const AgentsArguments& arguments) {
       return kExitFailure;
     }
     // Discovery window: done once every participant present has shown its heartbeat and
-    // no new agent appeared for a short while; never later than the timeout.
-    const auto deadline = std::chrono::steady_clock::now() + arguments.dds.timeout();
+    // no new agent appeared for a short while; never later than the timeout. A remote
+    // participant is discovered only when it announces itself (every announcement period,
+    // 1 s), so the window lasts at least one period and a margin: ending at the first
+    // heartbeat would miss agents whose announcement has not arrived yet.
+    const auto start = std::chrono::steady_clock::now();
+    const auto deadline = start + arguments.dds.timeout();
+    const auto listen_at_least_until = start + dds::ParticipantOptions{}.announcement_period + 500ms;
     auto remaining = [&] {
       return std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    };
+    auto quiet_period = [&] {
+      const auto to_minimum = std::chrono::duration_cast<std::chrono::milliseconds>(
+          listen_at_least_until - std::chrono::steady_clock::now());
+      return std::min(std::max(300ms, to_minimum), std::max(remaining(), 0ms));
     };
     while (remaining() > 0ms) {
       const bool complete = (*directory)->wait_until(
@@ -131,7 +142,7 @@ int run_agents(const AgentsArguments& arguments) {
       const auto present_before = present.names();
       const auto ids_before = agent_ids((*directory)->agents());
       (*directory)->wait_until([&](const auto& records) { return agent_ids(records) != ids_before; },
-                               std::min<std::chrono::milliseconds>(300ms, std::max(remaining(), 0ms)));
+                               quiet_period());
       if (present.names() == present_before && agent_ids((*directory)->agents()) == ids_before) break;
     }
     agents = (*directory)->live_agents();

@@ -140,6 +140,8 @@ class TopologyAgentTest : public ::testing::Test {
         },
         dds::ReaderOptions{dds::TopicQos::events(), {}, {}});
     ASSERT_TRUE(notices.has_value());
+    // Notices are events (VOLATILE): one sent before the match would be lost.
+    ASSERT_TRUE((*notices)->wait_for_writers(agents_.size(), kDiscoveryTimeout));
     readers_.push_back(std::shared_ptr<void>(std::move(*timelines)));
     readers_.push_back(std::shared_ptr<void>(std::move(*descriptions)));
     readers_.push_back(std::shared_ptr<void>(std::move(*notices)));

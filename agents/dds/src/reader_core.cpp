@@ -95,6 +95,7 @@ void ReaderCore::on_subscription_matched(fdds::DataReader*,
     std::lock_guard lock(match_mutex_);
     matched_.update(status.last_publication_handle, status.current_count_change);
   }
+  match_changed_.notify_all();
   if (on_match_) on_match_();
 }
 
@@ -121,6 +122,11 @@ std::vector<GuidPrefix_t> ReaderCore::matched_participants() const {
 std::size_t ReaderCore::matched_writers() const {
   std::lock_guard lock(match_mutex_);
   return matched_.endpoints();
+}
+
+bool ReaderCore::wait_for_writers(std::size_t count, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(match_mutex_);
+  return match_changed_.wait_for(lock, timeout, [&] { return matched_.endpoints() >= count; });
 }
 
 }  // namespace drover::dds::detail

@@ -55,6 +55,12 @@ class Reader {
   }
 
   std::size_t matched_writers() const { return core_->matched_writers(); }
+  /// Waits until at least `count` writers are matched. An events() topic is VOLATILE:
+  /// what a writer sends before the match never reaches this reader, so a reader that must
+  /// not miss an event waits for its writer first. \return whether they are matched.
+  bool wait_for_writers(std::size_t count, std::chrono::milliseconds timeout) const {
+    return core_->wait_for_writers(count, timeout);
+  }
 
  private:
   explicit Reader(std::unique_ptr<detail::ReaderCore> core) : core_(std::move(core)) {}

@@ -4,6 +4,8 @@
 // and which remote participants its writers belong to. Reader<T> and the services wrap it.
 
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -66,6 +68,8 @@ class ReaderCore final : private eprosima::fastdds::dds::DataReaderListener {
   bool matched(const eprosima::fastrtps::rtps::GuidPrefix_t& participant) const;
   std::vector<eprosima::fastrtps::rtps::GuidPrefix_t> matched_participants() const;
   std::size_t matched_writers() const;
+  /// Waits until at least `count` writers are matched. \return whether they are.
+  bool wait_for_writers(std::size_t count, std::chrono::milliseconds timeout) const;
 
   const std::string& topic_name() const noexcept { return spec_.topic; }
 
@@ -94,6 +98,7 @@ class ReaderCore final : private eprosima::fastdds::dds::DataReaderListener {
   eprosima::fastdds::dds::ContentFilteredTopic* filtered_topic_ = nullptr;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   mutable std::mutex match_mutex_;
+  mutable std::condition_variable match_changed_;
   MatchedParticipants matched_;
 };
 
