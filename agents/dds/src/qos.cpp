@@ -21,6 +21,12 @@ void apply(const TopicQos& qos, EndpointQos& out) {
     out.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
   }
   if (qos.deadline.count() > 0) out.deadline().period = to_duration(qos.deadline);
+  // Fast DDS limits keyed endpoints to 10 instances by default: a topology agent's
+  // entities, the vehicles' statuses and the orders are many more. <= 0 means unlimited
+  // (and Fast DDS then wants max_samples unlimited too; KEEP_LAST depth still bounds each
+  // instance).
+  out.resource_limits().max_instances = 0;
+  out.resource_limits().max_samples = 0;
 }
 
 }  // namespace
