@@ -34,6 +34,7 @@ struct LaunchArguments {
   std::string launch_file;
   std::optional<double> duration_s;
   std::optional<double> time_factor;
+  std::optional<std::uint32_t> domain_id;
   std::string trace_file;
   std::string state_dir;
   double stop_grace_s = 5;
@@ -83,12 +84,12 @@ std::string progress_line(const SharedClock& clock, const launcher::FleetFigures
                      figures.vehicles_reporting);
 }
 
-void print_summary(const launcher::LaunchFile& file, const SharedClock& clock,
+void print_summary(const launcher::LaunchFile& file, DurationNs ran_for,
                    const launcher::FleetFigures& figures, const launcher::SupervisorOutcome& outcome,
                    const launcher::TraceWriter* trace, const std::string& trace_file) {
   std::cout << fmt::format("summary of {} ({}): stopped on {} after {:.1f} s simulated\n",
                            file.name.empty() ? file.path.filename().string() : file.name, file.path.string(),
-                           outcome.stop_reason, ns_to_seconds(clock.now() - clock.epoch()));
+                           outcome.stop_reason, ns_to_seconds(ran_for));
   std::cout << fmt::format("  orders finished: {}\n  orders failed:   {}\n  orders open:     {}\n",
                            figures.orders.finished, figures.orders.failed, figures.orders.open);
   std::cout << fmt::format("  mean lead time:  {}\n", lead_time_text(figures.orders));
@@ -96,8 +97,8 @@ void print_summary(const launcher::LaunchFile& file, const SharedClock& clock,
                            figures.statuses);
   for (const auto& agent : outcome.agents) {
     if (agent.restarts == 0 && !agent.failed) continue;
-    std::cout << fmt::format("  agent {}: {} restart(s){}; last {}\n", agent.id, agent.restarts,
-                             agent.failed ? ", FAILED" : "", agent.last_end);
+    std::cout << fmt::format("  agent {}: {} restart(s){}; last failure: {}\n", agent.id, agent.restarts,
+                             agent.failed ? ", FAILED" : "", agent.last_failure);
   }
   if (trace != nullptr) std::cout << fmt::format("  trace:           {} ({} lines)\n", trace_file, trace->lines());
   std::cout.flush();
@@ -124,6 +125,7 @@ int run(const LaunchArguments& arguments) {
     return kExitBadInput;
   }
   if (arguments.time_factor) file->time_factor = *arguments.time_factor;
+  if (arguments.domain_id) file->domain_id = *arguments.domain_id;
   const TimeNs origin = SharedClock::unix_now();
   const TimeNs epoch = file->epoch_ns.value_or(origin);
   auto clock = SharedClock::create_at_origin(epoch, file->time_factor, origin);
@@ -186,6 +188,7 @@ int run(const LaunchArguments& arguments) {
     if (end && clock->now() >= *end) return fmt::format("--duration {} s", *arguments.duration_s);
     return std::nullopt;
   });
+
   console.end_progress();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
@@ -195,7 +198,10 @@ int run(const LaunchArguments& arguments) {
   monitor->reset();
   participant->reset();
   if (trace) trace->flush();
-  print_summary(*file, *clock, figures, *outcome, trace.get(), arguments.trace_file);
+  // The simulated time at which the stop was asked for, not after the agents ended.
+  const TimeNs stopped_at =
+      clock->now() - clock->to_sim(std::chrono::steady_clock::now() - outcome->stop_requested_at);
+  print_summary(*file, stopped_at - epoch, figures, *outcome, trace.get(), arguments.trace_file);
   return outcome->any_failed() ? kExitFailure : kExitOk;
 }
 
@@ -214,6 +220,8 @@ void add_launch_command(CLI::App& app, CommandContext& context) {
   command->add_option("--time-factor", arguments->time_factor,
                       "Shared-clock seconds per real second (overrides the launch file's)")
       ->check(CLI::PositiveNumber);
+  command->add_option("--domain", arguments->domain_id, "DDS domain id (overrides the launch file's)")
+      ->check(CLI::Range(0, 232));
   command->add_option("--trace", arguments->trace_file,
                       "Write every RAN status, topology event and order change as JSON lines");
   command->add_option("--state-dir", arguments->state_dir,

@@ -24,6 +24,7 @@ struct Supervisor::Agent {
   int restarts = 0;
   bool failed = false;
   std::string last_end;
+  std::string last_failure;
   std::optional<Clock::time_point> restart_at;
 };
 
@@ -106,6 +107,7 @@ Result<SupervisorOutcome> Supervisor::run(const Tick& tick) {
       if (auto reason = tick()) outcome.stop_reason = *reason;
     }
   }
+  outcome.stop_requested_at = Clock::now();
   console_.note("stopping (" + outcome.stop_reason + ")");
   bool kill_now = false;
   stop_all(kill_now);
@@ -115,7 +117,7 @@ Result<SupervisorOutcome> Supervisor::run(const Tick& tick) {
   }
   close_finished_streams();
   for (const auto& agent : agents_) {
-    outcome.agents.push_back({agent.entry.id, agent.restarts, agent.failed, agent.last_end});
+    outcome.agents.push_back({agent.entry.id, agent.restarts, agent.failed, agent.last_end, agent.last_failure});
   }
   return outcome;
 }
@@ -222,6 +224,7 @@ void Supervisor::on_exit(Agent& agent, int status) {
     console_.note(agent.entry.id + " " + agent.last_end);
     return;
   }
+  agent.last_failure = agent.last_end;
   if (agent.entry.restart == RestartPolicy::on_failure && agent.restarts < agent.entry.max_restarts) {
     ++agent.restarts;
     agent.restart_at = Clock::now() + options_.restart_delay;

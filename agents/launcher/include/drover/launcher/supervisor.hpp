@@ -39,11 +39,15 @@ struct AgentOutcome {
   bool failed = false;
   /// Its last end, described ("exited with code 1", "killed by signal 9 (SIGKILL)").
   std::string last_end;
+  /// Its last end on its own with a failure (a crash), described; empty: none.
+  std::string last_failure;
 };
 
 struct SupervisorOutcome {
   /// What made it stop: "signal SIGINT", "signal SIGTERM" or the tick's reason.
   std::string stop_reason;
+  /// When the stop was asked for (before the agents were stopped).
+  std::chrono::steady_clock::time_point stop_requested_at;
   std::vector<AgentOutcome> agents;
 
   bool any_failed() const;

@@ -1,0 +1,185 @@
+// The launch file parser: a good file becomes the agents' command lines; every kind of bad
+// file is refused with its problem named by field, and nothing is returned to start.
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "drover/launcher/launch_file.hpp"
+
+namespace drover::launcher {
+namespace {
+
+std::filesystem::path source_dir() {
+  const char* dir = std::getenv("DROVER_SOURCE_DIR");
+  return dir != nullptr ? dir : DROVER_TEST_SOURCE_DIR;
+}
+
+/// A launch file "in" launch/, so that "topologies/loop.json" resolves.
+std::filesystem::path launch_path() { return source_dir() / "launch" / "test.json"; }
+
+Result<LaunchFile, LaunchProblems> parse(const std::string& text) {
+  return parse_launch_file(text, launch_path(), "/state");
+}
+
+/// The problems of a file that must be refused, as "where: what" lines.
+std::string problems_of(const std::string& text) {
+  auto parsed = parse(text);
+  EXPECT_FALSE(parsed.has_value()) << "accepted a bad file:\n" << text;
+  if (parsed) return {};
+  std::string all;
+  for (const auto& problem : parsed.error()) all += problem.where + ": " + problem.what + "\n";
+  return all;
+}
+
+/// A loop launch file with `agents` as its agent list.
+std::string loop_file(const std::string& agents) {
+  return R"({"domain": 226, "time_factor": 5, "epoch": 1000, "topology": "topologies/loop.json",
+            "vehicle_profiles": {"slow": {"max_speed": 0.5, "load_duration": 2}}, "agents": [)" +
+         agents + "]}";
+}
+
+TEST(LaunchFile, GoodFileBecomesCommandLines) {
+  auto parsed = parse(loop_file(R"(
+      {"kind": "topology", "db": "loop.db", "restart": "on-failure", "max_restarts": 2},
+      {"kind": "routing", "id": "routing-1"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "profile": "slow", "loaded": true},
+      {"kind": "logical", "vehicle": "V1"},
+      {"kind": "load-generator", "seed": 7, "stations": ["station", "parking"]})"));
+  ASSERT_TRUE(parsed.has_value()) << parsed.error().front().where << ": " << parsed.error().front().what;
+  EXPECT_EQ(parsed->domain_id, 226u);
+  EXPECT_DOUBLE_EQ(parsed->time_factor, 5.0);
+  EXPECT_EQ(parsed->epoch_ns, 1000);
+  const auto topology = (source_dir() / "launch" / "topologies" / "loop.json").lexically_normal().string();
+  EXPECT_EQ(parsed->topology_file.string(), topology);
+  ASSERT_EQ(parsed->agents.size(), 5u);
+
+  const auto& store = parsed->agents[0];
+  EXPECT_EQ(store.id, "topology");
+  EXPECT_EQ(store.restart, RestartPolicy::on_failure);
+  EXPECT_EQ(store.max_restarts, 2);
+  EXPECT_EQ(store.options, (std::vector<std::string>{"--id", "topology", "--topology", topology, "--db", "/state/loop.db"}));
+
+  EXPECT_EQ(parsed->agents[1].options, (std::vector<std::string>{"--id", "routing-1"}));
+
+  // The entry's fields in key order (a profile's fields where "profile" comes).
+  const auto& ran = parsed->agents[2];
+  EXPECT_EQ(ran.id, "ran-V1");
+  EXPECT_EQ(ran.vehicle, "V1");
+  EXPECT_EQ(ran.options, (std::vector<std::string>{"--agent-id", "ran-V1", "--id", "V1", "--topology", topology,
+                                                   "--at", "south-west", "--loaded", "--load-duration", "2",
+                                                   "--max-speed", "0.5"}));
+  EXPECT_EQ(parsed->agents[3].id, "V1");
+  EXPECT_EQ(parsed->agents[4].options,
+            (std::vector<std::string>{"--id", "load-generator", "--topology", topology, "--seed", "7", "--station",
+                                      "station", "--station", "parking"}));
+  EXPECT_EQ(subcommand(AgentKind::topology), "topology-agent");
+  EXPECT_EQ(subcommand(AgentKind::ran_sim), "ran-sim");
+}
+
+TEST(LaunchFile, NotJsonOrNotAnObject) {
+  EXPECT_NE(problems_of("{\"agents\": [").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(problems_of("[1, 2]").find("must be a JSON object"), std::string::npos);
+}
+
+TEST(LaunchFile, MissingOrBadHeaderFields) {
+  const auto missing = problems_of(R"({"agents": [{"kind": "routing"}]})");
+  EXPECT_NE(missing.find("topology: missing"), std::string::npos) << missing;
+  const auto bad = problems_of(R"({"domain": 233, "time_factor": -1, "epoch": "soon", "topology": "topologies/loop.json",
+                                   "agents": [{"kind": "routing"}], "colour": "red"})");
+  EXPECT_NE(bad.find("domain: must be an integer DDS domain id in 0..232"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("time_factor: must be a positive number"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("epoch: must be \"now\" or an integer"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("colour: unknown field"), std::string::npos) << bad;
+  const auto no_agents = problems_of(R"({"topology": "topologies/loop.json", "agents": []})");
+  EXPECT_NE(no_agents.find("agents: must be a non-empty array"), std::string::npos) << no_agents;
+}
+
+TEST(LaunchFile, TopologyThatDoesNotLoad) {
+  const auto absent = problems_of(R"({"topology": "topologies/absent.json", "agents": [{"kind": "routing"}]})");
+  EXPECT_NE(absent.find("topology: "), std::string::npos) << absent;
+  EXPECT_NE(absent.find("absent.json"), std::string::npos) << absent;
+}
+
+TEST(LaunchFile, UnknownKindAndFieldsAreNamed) {
+  const auto text = problems_of(loop_file(R"({"kind": "teleporter"},
+      {"kind": "routing", "partition": "west"},
+      {"kind": "topology", "restart": "sometimes", "max_restarts": -1})"));
+  EXPECT_NE(text.find("agents[0].kind: unknown kind 'teleporter' (expected one of topology, ran-sim"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("agents[1].partition: unknown field for kind 'routing'"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[2].restart: must be \"never\" or \"on-failure\""), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[2].max_restarts: must be an integer in 0..1000"), std::string::npos) << text;
+}
+
+TEST(LaunchFile, VerticesPartitionsAndProfilesMustExist) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology", "partition": "north"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "nowhere", "profile": "fast"},
+      {"kind": "ran-sim", "vehicle": "V2"},
+      {"kind": "load-generator", "stations": ["station", "south-west->south"]})"));
+  EXPECT_NE(text.find("agents[0].partition: the topology has no partition 'north'"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[1].at: 'nowhere' is not a vertex of"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[1].profile: names no entry of vehicle_profiles"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[2].at: missing"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].stations[1]: 'south-west->south' is not a vertex"), std::string::npos) << text;
+}
+
+TEST(LaunchFile, BadProfileFields) {
+  const auto text = problems_of(R"({"topology": "topologies/loop.json",
+      "vehicle_profiles": {"x": {"max_speed": 0, "warp": 9}, "y": 3}, "agents": [{"kind": "routing"}]})");
+  EXPECT_NE(text.find("vehicle_profiles.x.max_speed: must be a number > 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("vehicle_profiles.x.warp: unknown field"), std::string::npos) << text;
+  EXPECT_NE(text.find("vehicle_profiles.y: must be an object"), std::string::npos) << text;
+}
+
+TEST(LaunchFile, DuplicateIdsAndVehicles) {
+  const auto text = problems_of(loop_file(R"({"kind": "routing"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
+      {"kind": "ran-sim", "vehicle": "V1", "id": "other", "at": "north-east"},
+      {"kind": "logical", "vehicle": "V2", "id": "V3"},
+      {"kind": "ran-sim", "vehicle": "V4", "id": "bad id!", "at": "charger"})"));
+  EXPECT_NE(text.find("agents[1].id: agent id 'routing' is used by agents[0] too"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].vehicle: vehicle 'V1' has a ran-sim at agents[2] already"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("agents[4].id: a logical agent's id is its vehicle id"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[5].id: "), std::string::npos) << text;
+}
+
+TEST(LaunchFile, VehiclesMustNotStartOnOneOrConflictingVertices) {
+  const auto same = problems_of(loop_file(R"({"kind": "ran-sim", "vehicle": "V1", "at": "south"},
+      {"kind": "ran-sim", "vehicle": "V2", "at": "south"})"));
+  EXPECT_NE(same.find("agents[1].at: 'south' is, or conflicts with, the start of agents[0]"), std::string::npos)
+      << same;
+  // Apart: accepted.
+  EXPECT_TRUE(parse(loop_file(R"({"kind": "ran-sim", "vehicle": "V1", "at": "south"},
+      {"kind": "ran-sim", "vehicle": "V2", "at": "north"})")).has_value());
+}
+
+TEST(LaunchFile, EveryPartitionNeedsATopologyAgent) {
+  // The warehouse has partitions west and east.
+  const std::string text = R"({"topology": "topologies/warehouse.json", "agents": [
+      {"kind": "topology", "partition": "west"}, {"kind": "topology", "partition": "west", "id": "again"}]})";
+  const auto problems = problems_of(text);
+  EXPECT_NE(problems.find("agents: no topology agent serves partition 'east'"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("agents[1].partition: partition 'west' is served by agents[0] already"),
+            std::string::npos) << problems;
+}
+
+TEST(LaunchFile, UnreadableFile) {
+  auto loaded = load_launch_file("/nonexistent/launch.json", "/state");
+  ASSERT_FALSE(loaded.has_value());
+  EXPECT_EQ(loaded.error().front().what, "cannot read the file");
+}
+
+TEST(LaunchFile, BundledWarehouseIsValid) {
+  auto loaded = load_launch_file(source_dir() / "launch" / "warehouse.json", "/state");
+  ASSERT_TRUE(loaded.has_value()) << loaded.error().front().where << ": " << loaded.error().front().what;
+  std::size_t vehicles = 0;
+  for (const auto& agent : loaded->agents) vehicles += agent.kind == AgentKind::ran_sim ? 1 : 0;
+  EXPECT_GE(vehicles, 8u);
+}
+
+}  // namespace
+}  // namespace drover::launcher
