@@ -3,6 +3,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -28,8 +29,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// A line a - b - c - d; a, b and their edges are partition west, c, d and c-d east. Edge
-// footprints overlap their end vertices, so a reservation on a vertex shadows its edges.
+// A line a - b - c - d; a, b and their edges are partition west, c, d and c-d east. The
+// edges' footprints are given and run from vertex to vertex, so they overlap the (generated)
+// footprints of their end vertices: a reservation on a vertex shadows its edges and back
+// (generated edge footprints would stop short of the vertices and conflict with nothing).
 constexpr const char* kLineTopology = R"({
   "name": "line",
   "vertices": [
@@ -39,9 +42,12 @@ constexpr const char* kLineTopology = R"({
     {"id": "d", "x": 9, "y": 0, "partition": "east"}
   ],
   "edges": [
-    {"id": "a-b", "from": "a", "to": "b", "bidirectional": true, "max_speed": 1.0, "partition": "west"},
-    {"id": "b-c", "from": "b", "to": "c", "bidirectional": true, "max_speed": 1.0, "partition": "west"},
-    {"id": "c-d", "from": "c", "to": "d", "bidirectional": true, "max_speed": 1.0, "partition": "east"}
+    {"id": "a-b", "from": "a", "to": "b", "bidirectional": true, "max_speed": 1.0, "footprint": [[0, -0.7], [3, -0.7], [3, 0.7], [0, 0.7]],
+     "partition": "west"},
+    {"id": "b-c", "from": "b", "to": "c", "bidirectional": true, "max_speed": 1.0, "footprint": [[3, -0.7], [6, -0.7], [6, 0.7], [3, 0.7]],
+     "partition": "west"},
+    {"id": "c-d", "from": "c", "to": "d", "bidirectional": true, "max_speed": 1.0, "footprint": [[6, -0.7], [9, -0.7], [9, 0.7], [6, 0.7]],
+     "partition": "east"}
   ]
 })";
 
@@ -291,11 +297,24 @@ TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingP
   EXPECT_EQ(after_commit.reservations()[0].agent(), "v1");
   EXPECT_EQ(after_commit.reservations()[0].window().start(), 1000);
   EXPECT_FALSE(after_commit.reservations()[0].prepared());
+  // The footprint of edge a-b overlaps vertex a: the reservation shadows it.
+  const auto shadowed = timeline_at("a-b", 2);
+  ASSERT_EQ(shadowed.reservations().size(), 1u);
+  EXPECT_EQ(shadowed.reservations()[0].agent(), "v1");
+  EXPECT_EQ(shadowed.reservations()[0].origin(), "a");
+  EXPECT_EQ(shadowed.reservations()[0].entity(), "a-b");
+  EXPECT_EQ(shadowed.reservations()[0].window().start(), 1000);
+  EXPECT_EQ(shadowed.reservations()[0].window().end(), 2000);
+  EXPECT_FALSE(shadowed.reservations()[0].prepared());
 
   // Another agent overlapping v1: conflict. A plan made on an old version: conflict.
   auto rejected = prepare_->call(prepare_request("v2", 7, items("v2", 7, {{"a", {1500, 2500}}})), kDiscoveryTimeout);
   ASSERT_TRUE(rejected.has_value());
   EXPECT_EQ(rejected->error().code(), msg::ERROR_CONFLICT) << rejected->error().message();
+  auto stale = prepare_->call(prepare_request("v2", 7, items("v2", 7, {{"a", {5000, 6000}}}), {{"a", 1}}),
+                              kDiscoveryTimeout);
+  ASSERT_TRUE(stale.has_value());
+  EXPECT_EQ(stale->error().code(), msg::ERROR_CONFLICT) << stale->error().message();
 
   // A later change on d is published after anything the rejected calls could have sent.
   reserve("v3", 1, {{"d", {0, 10}}});
@@ -472,8 +491,32 @@ TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
   const std::vector<std::pair<std::string, topology::Interval>> route{{"b-c", {200, 210}}, {"c", {210, 400}}};
   reserve("v1", 1, route, "topology-west", "west");
   reserve("v1", 1, route, "topology-east", "east");
-  EXPECT_TRUE(wait_until([&] { return !timelines_["b-c"].reservations().empty(); }));
-  EXPECT_TRUE(wait_until([&] { return !timelines_["c"].reservations().empty(); }));
+  // Every item of the route, real and shadow, is on its owner's timeline and nothing else
+  // is: each partition's agent stored exactly its share, committed.
+  std::map<std::string, std::vector<msg::Reservation>> expected;
+  std::size_t shadows = 0;
+  for (auto item : items("v1", 1, route)) {
+    shadows += item.origin() != item.entity() ? 1 : 0;
+    expected[item.entity()].push_back(std::move(item));
+  }
+  ASSERT_GE(shadows, 2u) << "b-c and c conflict: each step shadows the other";
+  for (const auto& [entity, entity_items] : expected) {
+    EXPECT_TRUE(wait_until([&, &entity = entity, &entity_items = entity_items] {
+      const auto& reservations = timelines_[entity].reservations();
+      if (reservations.size() != entity_items.size()) return false;
+      for (const auto& wanted : entity_items) {
+        if (std::find(reservations.begin(), reservations.end(), wanted) == reservations.end()) return false;
+      }
+      return true;
+    })) << "timeline of " << entity << " holds exactly the route's " << entity_items.size() << " item(s)";
+  }
+  {
+    std::lock_guard guard(mutex_);
+    EXPECT_TRUE(timelines_["a"].reservations().empty());
+    EXPECT_TRUE(timelines_["d"].reservations().empty());
+    ASSERT_EQ(timelines_["c"].locks().size(), 1u);
+    EXPECT_EQ(timelines_["c"].locks()[0].id(), "topology-east/1");
+  }
 }
 
 TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
