@@ -27,27 +27,14 @@ struct Blocker {
   EntityIndex entity;
   int start;
   int end;
-  bool lock;
 };
 
-/// When a reservation of `g` keeps another agent off `e`: the TimelineSet rule that items
-/// (real or shadow) of different agents never overlap on one timeline, so a reservation of
-/// g (which writes items on g and C(g)) blocks e (which needs e and C(e)) when the two sets
-/// meet. A lock on x blocks e when x is e or in C(e).
-bool reservation_blocks(const Topology& t, EntityIndex g, EntityIndex e) {
-  const auto with_self = [&t](EntityIndex x) {
-    std::vector<EntityIndex> set(t.conflicts(x).begin(), t.conflicts(x).end());
-    set.push_back(x);
-    std::sort(set.begin(), set.end());
-    return set;
-  };
-  const auto a = with_self(g);
-  const auto b = with_self(e);
-  std::vector<EntityIndex> common;
-  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
-  return !common.empty();
-}
-bool lock_blocks(const Topology& t, EntityIndex x, EntityIndex e) {
+/// When a reservation or a lock on `x` keeps another agent off `e`: when x is e or in C(e).
+/// For reservations this is DESIGN's I1 (reservations of different agents on entities whose
+/// footprints overlap never overlap in time); a shadow stands for its real reservation, so
+/// two entities that both conflict with a third but not with each other may be used at the
+/// same time. A lock makes its entity unavailable to every footprint overlapping it.
+bool blocks(const Topology& t, EntityIndex x, EntityIndex e) {
   const auto c = t.conflicts(e);
   return x == e || std::find(c.begin(), c.end(), x) != c.end();
 }
@@ -65,7 +52,7 @@ class BruteForce {
     for (EntityIndex e = 0; e < entities; ++e) {
       std::vector<int> slot(kGrid, 0);
       for (const Blocker& b : blockers) {
-        if (!(b.lock ? lock_blocks(t, b.entity, e) : reservation_blocks(t, b.entity, e))) continue;
+        if (!blocks(t, b.entity, e)) continue;
         for (int s = b.start; s < std::min(b.end, kGrid); ++s) slot[s] = 1;
         if (b.end == kNever) forever_from_[e] = std::min(forever_from_[e], b.start);
       }
@@ -214,7 +201,7 @@ std::vector<Blocker> random_traffic(World& w, std::mt19937& rng) {
       const int until = coin(rng) < 0.03 ? kNever : from + length(rng);
       const topology::Interval window{sec(from), until == kNever ? kForever : sec(until)};
       if (w.timelines.reserve(agent, w.next_route++, {{e, window}}) && agent[0] != 'a') {
-        blockers.push_back(Blocker{e, from, until, false});
+        blockers.push_back(Blocker{e, from, until});
       }
     }
   }
@@ -224,7 +211,7 @@ std::vector<Blocker> random_traffic(World& w, std::mt19937& rng) {
     const int until = coin(rng) < 0.1 ? kNever : from + length(rng);
     const topology::Interval window{sec(from), until == kNever ? kForever : sec(until)};
     if (w.timelines.lock(e, window, "operator", "random")) {
-      blockers.push_back(Blocker{e, from, until, true});
+      blockers.push_back(Blocker{e, from, until});
     }
   }
   return blockers;

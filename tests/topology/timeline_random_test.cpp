@@ -82,9 +82,24 @@ class RandomRun {
   /// What the run exercised, so a test can insist that it was not vacuous.
   struct Coverage {
     std::size_t reserved = 0, rejected = 0, granted = 0, queued = 0, late_grants = 0,
-                pushed = 0, hit_locks = 0, lock_hits = 0, expired = 0;
+                pushed = 0, hit_locks = 0, lock_hits = 0, expired = 0,
+                shared_timelines = 0;  // states where two agents' shadows overlap on a timeline
   };
   const Coverage& coverage() const { return coverage_; }
+  /// Whether some entity conflicts with two that do not conflict with each other (whose
+  /// shadows may then overlap on its timeline).
+  bool has_shadow_sharing_entities() const {
+    for (const auto& set : conflicts_) {
+      for (EntityIndex a : set) {
+        for (EntityIndex c : set) {
+          if (a != c && !std::binary_search(conflicts_[a].begin(), conflicts_[a].end(), c)) {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
 
  private:
   template <class T>
@@ -438,6 +453,21 @@ class RandomRun {
     return s;
   }
 
+  /// Whether shadows of two agents overlap on some timeline (allowed when their origins do
+  /// not conflict): the case where I1 is less strict than "one agent per timeline".
+  static bool shadows_share_a_timeline(const Snapshot& s) {
+    for (const Timeline& t : s.timelines) {
+      for (const Reservation& a : t.reservations) {
+        for (const Reservation& b : t.reservations) {
+          if (a.shadow() && b.shadow() && a.agent != b.agent && a.window.overlaps(b.window)) {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
   void check_state(const TimelineSet& before, const Snapshot& ref_before, bool ok) {
     if (ok) ++successes_;
     if (!ok) {
@@ -453,6 +483,7 @@ class RandomRun {
       EXPECT_EQ(s.timelines[e], want.timelines[e]) << "timeline " << e;
     }
     EXPECT_TRUE(s.held == want.held) << "the allocated reservations differ from the reference";
+    if (shadows_share_a_timeline(s)) ++coverage_.shared_timelines;
     for (const auto& check : {reference::check_exclusive(s), reference::check_allocations(s),
                               reference::check_locks(s, excused_)}) {
       for (const std::string& v : check) ADD_FAILURE() << v;
@@ -494,6 +525,9 @@ TEST_P(TimelineRandom, MatchesReferenceAndKeepsInvariants) {
   EXPECT_GE(c.hit_locks, 5u);
   EXPECT_GE(c.lock_hits, 5u);
   EXPECT_GE(c.expired, 1u);
+  if (run.has_shadow_sharing_entities()) {
+    EXPECT_GE(c.shared_timelines, 20u);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, TimelineRandom, ::testing::Range<std::uint64_t>(1, 21));

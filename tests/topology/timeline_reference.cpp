@@ -66,6 +66,13 @@ bool contains(const std::vector<EntityIndex>& set, EntityIndex e) {
   return std::find(set.begin(), set.end(), e) != set.end();
 }
 
+/// Whether reservations of two agents standing for entities a and b (their origins) may
+/// not overlap (I1): the same entity, or entities whose footprints overlap.
+bool origins_conflict(const std::vector<std::vector<EntityIndex>>& conflicts, EntityIndex a,
+                      EntityIndex b) {
+  return a == b || contains(conflicts[a], b);
+}
+
 bool add_overflows(TimeNs a, DurationNs b, TimeNs& out) {
   return __builtin_add_overflow(a, b, &out) || out == kForever;
 }
@@ -185,7 +192,11 @@ std::vector<Interval> ReferenceTimelines::free_windows(EntityIndex entity, const
   }
   for (const Item& item : items_) {
     const Reservation& r = item.reservation;
-    if (!contains(place, r.entity) || r.agent == agent) continue;
+    // A step on `entity` writes on `place`; what is there stands for its origin.
+    if (!contains(place, r.entity) || r.agent == agent ||
+        !origins_conflict(conflicts_, r.origin, entity)) {
+      continue;
+    }
     blocked.push_back(held(r) ? Interval{std::numeric_limits<TimeNs>::min(), r.window.end}
                               : r.window);
   }
@@ -246,7 +257,7 @@ Status ReferenceTimelines::admit(const std::vector<Reservation>& items,
       if (q.agent == r.agent && q.route == r.route && q.step == r.step) {
         return fail(ErrorCode::conflict, "step twice");
       }
-      if (q.agent != r.agent &&
+      if (q.agent != r.agent && origins_conflict(conflicts_, q.origin, r.origin) &&
           (q.window.overlaps(r.window) || (held(q) && r.window.start < q.window.start))) {
         return fail(ErrorCode::conflict, "overlap or overtaking a holder");
       }
@@ -444,7 +455,8 @@ Result<DelayReport> ReferenceTimelines::delay(const AgentId& agent, RouteId rout
       for (const Item& y : items_) {
         const Reservation& a = x.reservation;
         const Reservation& b = y.reservation;
-        if (a.entity != b.entity || a.agent == b.agent || a.window.start >= b.window.start) {
+        if (a.entity != b.entity || a.agent == b.agent || a.window.start >= b.window.start ||
+            !origins_conflict(conflicts_, a.origin, b.origin)) {
           continue;
         }
         const TimeNs blocker_end = new_end(a);
@@ -540,7 +552,8 @@ std::vector<std::string> check_exclusive(const Snapshot& s) {
     const auto& rs = s.timelines[e].reservations;
     for (std::size_t i = 0; i < rs.size(); ++i) {
       for (std::size_t j = i + 1; j < rs.size(); ++j) {
-        if (rs[i].agent != rs[j].agent && rs[i].window.overlaps(rs[j].window)) {
+        if (rs[i].agent != rs[j].agent && rs[i].window.overlaps(rs[j].window) &&
+            origins_conflict(s.conflicts, rs[i].origin, rs[j].origin)) {
           out.push_back("I1 timeline " + std::to_string(e) + ": " + text(rs[i]) + " overlaps " +
                         text(rs[j]));
         }
@@ -708,7 +721,10 @@ std::vector<std::string> check_delay(const Snapshot& before, const Snapshot& aft
     const auto& rs = before.timelines[e].reservations;
     for (const Reservation& a : rs) {
       for (const Reservation& b : rs) {
-        if (a.agent == b.agent || a.window.start >= b.window.start) continue;
+        if (a.agent == b.agent || a.window.start >= b.window.start ||
+            !origins_conflict(before.conflicts, a.origin, b.origin)) {
+          continue;
+        }
         const Reservation& na = new_by_key[key_of(a)];
         const Reservation& nb = new_by_key[key_of(b)];
         if (na.window.start >= nb.window.start) {
@@ -758,6 +774,7 @@ std::vector<std::string> check_delay(const Snapshot& before, const Snapshot& aft
       const Reservation& now = new_by_key[k];
       for (const Reservation& x : before.timelines[old.entity].reservations) {
         if (x.agent != old.agent && x.window.start < old.window.start &&
+            origins_conflict(before.conflicts, x.origin, old.origin) &&
             new_by_key[key_of(x)].window.end == now.window.start) {
           tight = true;
         }

@@ -113,8 +113,9 @@ class ReferenceTimelines {
 
 // ---- invariant checkers: each returns one line per violation, empty when all hold ----
 
-/// I1: on each timeline different agents' reservations never overlap; real reservations
-/// of different agents on e and on f in C(e) never overlap; every real reservation has its
+/// I1: on each timeline different agents' reservations whose origins conflict (are equal
+/// or in each other's conflict set) never overlap; real reservations of different agents on
+/// e and on f in C(e) never overlap; every real reservation has its
 /// shadow on each member of its conflict set and every shadow its real one.
 std::vector<std::string> check_exclusive(const Snapshot& s);
 
@@ -124,8 +125,8 @@ std::vector<std::string> check_exclusive(const Snapshot& s);
 /// there and is not the holder.
 std::vector<std::string> check_allocations(const Snapshot& s);
 
-/// I3 for one delay of (agent, route) from `step` by `by`: the order of different agents
-/// on every timeline is unchanged; the delayed route's step ends `by` later and its later
+/// I3 for one delay of (agent, route) from `step` by `by`: the order of different agents'
+/// reservations with conflicting origins on every timeline is unchanged; the delayed route's step ends `by` later and its later
 /// steps moved by exactly `by`, its earlier ones not at all; the report names the delayed
 /// route first and then exactly the other routes whose windows moved, with the step from
 /// which and how far; hit_locks lists exactly the moved reservations that overlap a lock;

@@ -86,13 +86,58 @@ TEST_F(TimelineTest, OtherAgentsNeverOverlapOnAnEntityOrItsConflictSet) {
   EXPECT_TRUE(set.reserve("amy", 4, {at(0, 12, 18)}));  // own reservations may overlap
 }
 
-TEST(TimelineShadows, ShadowsOfDifferentAgentsExcludeEachOther) {
-  // 0 - 1 - 2: 0 and 2 do not conflict, but both conflict with 1, whose timeline then
-  // holds both shadows: exclusive per timeline, conservative for 0 and 2.
+TEST(TimelineShadows, ShadowsOfEntitiesThatDoNotConflictShareATimeline) {
+  // 0 - 1 - 2: 0 and 2 do not conflict, but both conflict with 1, whose timeline then holds
+  // both shadows at once (I1 is about 0 and 2 themselves, which may be used together).
   TimelineSet set(graph(3, {{0, 1}, {1, 2}}));
   ASSERT_TRUE(set.reserve("amy", 1, {at(0, 0, 10)}));
-  EXPECT_EQ(set.reserve("bob", 1, {at(2, 5, 15)}).error().code, ErrorCode::conflict);
-  EXPECT_TRUE(set.free_windows(2, "bob", 0, 20) == windows({{10, 20}}));
+  EXPECT_TRUE(set.free_windows(2, "bob", 0, 20) == windows({{0, 20}}));
+  ASSERT_TRUE(set.reserve("bob", 1, {at(2, 5, 15)}));
+  EXPECT_EQ(set.timeline(1).reservations.size(), 2u);
+  // Each shadow still stands for its real reservation: 1 itself is blocked by both.
+  EXPECT_TRUE(set.free_windows(1, "cat", 0, 20) == windows({{15, 20}}));
+  EXPECT_EQ(set.reserve("cat", 1, {at(1, 12, 20)}).error().code, ErrorCode::conflict);
+  ASSERT_TRUE(set.reserve("cat", 2, {at(1, 20, 30)}));
+  // Both may hold their entity at once; 1 waits for both (two reservations before cat's).
+  EXPECT_TRUE(set.allocate("amy", 0)->granted);
+  EXPECT_TRUE(set.allocate("bob", 2)->granted);
+  const auto cat = set.allocate("cat", 1);
+  EXPECT_FALSE(cat->granted);
+  EXPECT_EQ(cat->queue_position, 2u);
+  // A held shadow blocks only steps on entities its origin conflicts with: amy may come
+  // back to 0 before bob's allocated step on 2 ends, as 0 and 2 do not conflict.
+  EXPECT_TRUE(set.reserve("amy", 2, {at(0, 12, 14)}));
+}
+
+TEST(TimelineShadows, ADelayPushesOnlyConflictingReservations) {
+  TimelineSet set(graph(3, {{0, 1}, {1, 2}}));
+  ASSERT_TRUE(set.reserve("amy", 1, {at(0, 0, 10)}));
+  ASSERT_TRUE(set.reserve("bob", 1, {at(2, 5, 15)}));
+  ASSERT_TRUE(set.reserve("cat", 1, {at(1, 20, 30)}));
+  const auto report = set.delay("amy", 1, 0, 15);  // amy on 0 until 25
+  ASSERT_TRUE(report.has_value());
+  // bob's shadow on 1 is overtaken by amy's (they do not conflict); cat waits for amy.
+  EXPECT_EQ(report->shifts, (std::vector<Shift>{{"amy", 1, 0, 15}, {"cat", 1, 0, 5}}));
+  EXPECT_EQ(set.timeline(2).reservations.front().window, (Interval{5, 15}));
+  EXPECT_EQ(set.timeline(1).reservations.back().window, (Interval{25, 35}));
+}
+
+TEST(TimelineShadows, TheCheckerTellsConflictingShadowsFromOthers) {
+  TimelineSet set(graph(3, {{0, 1}, {1, 2}}));
+  ASSERT_TRUE(set.reserve("amy", 1, {at(0, 0, 10)}));
+  ASSERT_TRUE(set.reserve("bob", 1, {at(2, 5, 15)}));
+  reference::Snapshot s{graph(3, {{0, 1}, {1, 2}}), {}, {}};
+  for (EntityIndex e = 0; e < 3; ++e) s.timelines.push_back(set.timeline(e));
+  EXPECT_TRUE(reference::check_exclusive(s).empty());
+  // The same timelines where 0 and 2 conflict (with their shadows on each other added)
+  // break I1 on every timeline.
+  reference::Snapshot triangle = s;
+  triangle.conflicts = graph(3, {{0, 1}, {1, 2}, {0, 2}});
+  triangle.timelines[2].reservations.insert(triangle.timelines[2].reservations.begin(),
+                                             Reservation{"amy", 1, 0, 2, 0, {0, 10}, false});
+  triangle.timelines[0].reservations.push_back(Reservation{"bob", 1, 0, 0, 2, {5, 15}, false});
+  const auto violations = reference::check_exclusive(triangle);
+  EXPECT_GE(violations.size(), 3u);  // on 0, on 1 (shadows), on 2; and the real pair
 }
 
 TEST_F(TimelineTest, PrepareRejectsMalformedRequestsWithInvalidArgument) {

@@ -58,6 +58,11 @@ bool TimelineSet::Impl::in_conflict_set(const TimelineSet& set, EntityIndex orig
   return std::binary_search(conflicts.begin(), conflicts.end(), entity);
 }
 
+bool TimelineSet::Impl::origins_conflict(const TimelineSet& set, EntityIndex a,
+                                         EntityIndex b) {
+  return a == b || in_conflict_set(set, a, b);
+}
+
 bool TimelineSet::Impl::is_held(const TimelineSet& set, const Reservation& r) {
   if (!set.owns(r.origin)) return false;
   const auto& held = set.held_[r.origin];

@@ -5,8 +5,10 @@
 // longer before moving on). The delayed route starts with level(d + 1) = by. Whenever a
 // reservation Y of one agent starts before a reservation X of another agent that came
 // before it on the same timeline ends, Y's route gets level(step of Y) >= X's new end -
-// Y's start: it waits at its previous step until X is gone. Levels only rise, each to the
-// least value that satisfies its constraint, so the result is the least fixpoint
+// Y's start: it waits at its previous step until X is gone. Only X and Y whose origins
+// conflict constrain each other (I1): shadows of two non-conflicting entities may overlap
+// and keep no order. Levels only rise, each to the least value that satisfies its
+// constraint, so the result is the least fixpoint
 // (independent of the order of work). It exists and stays <= by everywhere, as shifting
 // every route by `by` satisfies every constraint, so the iteration ends.
 // Everything is computed first and applied only when no time would overflow: atomic.
@@ -146,13 +148,26 @@ Result<DelayReport> TimelineSet::delay(const AgentId& agent, RouteId route, Enti
     return found == levels.end() ? unmoved : found->second;
   };
 
+  std::vector<std::pair<const Reservation*, TimeNs>> seen_shadows;  // reused per timeline
   while (!work.empty()) {
     const EntityIndex x = work.front();
     work.pop_front();
     queued[x] = false;
-    LatestEnds seen;  // over the reservations before the current one, in the original order
+    // Over the reservations before the current one, in the original order: a real one
+    // (origin x) conflicts with everything on x, a shadow with the real ones and with the
+    // shadows whose origins conflict with its own (I1); others do not push it.
+    LatestEnds seen, seen_real;
+    seen_shadows.clear();
     for (const Reservation& r : timelines_[x].reservations) {
-      const TimeNs blocker_end = seen.excluding(r.agent);
+      TimeNs blocker_end = r.origin == x ? seen.excluding(r.agent) : seen_real.excluding(r.agent);
+      if (r.origin != x) {
+        for (const auto& [shadow, end] : seen_shadows) {
+          if (end > blocker_end && shadow->agent != r.agent &&
+              Impl::origins_conflict(*this, shadow->origin, r.origin)) {
+            blocker_end = end;
+          }
+        }
+      }
       if (blocker_end > r.window.start + levels_of(r).at(r.step) &&
           levels[key_of(r)].raise(r.step, blocker_end - r.window.start)) {
         for (EntityIndex y : entities_of[key_of(r)]) {
@@ -163,9 +178,14 @@ Result<DelayReport> TimelineSet::delay(const AgentId& agent, RouteId route, Enti
         }
       }
       const RouteLevels& mine = levels_of(r);
-      seen.add(r.agent, r.window.end == kForever
-                            ? kForever
-                            : r.window.end + mine.at(std::uint64_t{r.step} + 1));
+      const TimeNs end =
+          r.window.end == kForever ? kForever : r.window.end + mine.at(std::uint64_t{r.step} + 1);
+      seen.add(r.agent, end);
+      if (r.origin == x) {
+        seen_real.add(r.agent, end);
+      } else {
+        seen_shadows.emplace_back(&r, end);
+      }
     }
   }
 

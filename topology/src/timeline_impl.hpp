@@ -4,6 +4,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drover/topology/timeline.hpp"
@@ -20,6 +21,11 @@ struct TimelineSet::Impl {
   static void bump_versions(TimelineSet& set, const TouchedSet& touched);
 
   static bool in_conflict_set(const TimelineSet& set, EntityIndex origin, EntityIndex entity);
+  /// True when reservations standing for origins a and b may not overlap in time if they
+  /// belong to different agents (I1): a == b or a in C(b). Two reservations on one
+  /// timeline x conflict exactly when their origins do: a real one (origin x) conflicts
+  /// with everything on x; two shadows on x conflict only if their origins do.
+  static bool origins_conflict(const TimelineSet& set, EntityIndex a, EntityIndex b);
 
   /// True when `r` belongs to an allocation: r's origin is owned and held by r's agent at
   /// r's route step (so r is the held real reservation or one of its shadows).
@@ -29,6 +35,23 @@ struct TimelineSet::Impl {
   static void remove_reservations(TimelineSet& set,
                                   const std::function<bool(const Reservation&)>& doomed,
                                   TouchedSet& touched);
+
+  /// What a free-window query asks: blockers of a step of `agent` on `entity`, within
+  /// [from, until), with or without locks.
+  struct BlockRule {
+    std::string_view agent;
+    EntityIndex entity = kNoEntity;
+    TimeNs from = 0;
+    TimeNs until = 0;
+    bool count_locks = true;
+  };
+  /// Appends to `out` what keeps the rule's step from writing on timeline x (x is the
+  /// step's entity or a member of its conflict set), clipped to [from, until), in no
+  /// particular order: the free-window rule. With `shadows` given, x's locks and real
+  /// reservations go to `out` and every other agent's shadow on x to `shadows` with its
+  /// origin, unfiltered (the caller filters them per step entity).
+  static void append_blocked(const TimelineSet& set, EntityIndex x, const BlockRule& rule,
+                             std::vector<Interval>& out, std::vector<ShadowBlock>* shadows);
 
   /// Every check of prepare (see its contract), for `op` ("prepare" or "reserve").
   static Status admit(const TimelineSet& set, const std::vector<Reservation>& items,

@@ -120,6 +120,9 @@ Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reserv
         }
         continue;
       }
+      // Shadows of two entities that do not conflict may share a timeline at any time:
+      // they stand for reservations elsewhere that I1 lets overlap.
+      if (!origins_conflict(set, r.origin, item.origin)) continue;
       if (r.window.overlaps(item.window)) {
         return fail(ErrorCode::conflict, where + ": overlaps " + owner_text(r));
       }

@@ -1,8 +1,10 @@
 // The free-window query: TimelineSet::append_free_windows (free_windows returns the same),
 // with or without a FreeWindowQuery that remembers what each timeline blocks. This file
-// holds the rule: the blockers of a step on e are the locks and other agents' reservations
-// on e and on the owned members of its conflict set (a step writes on all of them), a held
-// (allocated) reservation blocking from `from` on.
+// holds the rule: a step on e writes on e and on the owned members f of C(e); it is blocked
+// by the locks there and by other agents' reservations there whose origin conflicts with e
+// (I1): every reservation on e, the real ones on f, and shadows on f of e itself or of a
+// member of C(e) (a shadow on f of an entity that does not conflict with e stands for a
+// reservation e may overlap). A held (allocated) reservation blocks from `from` on.
 
 #include <algorithm>
 #include <cassert>
@@ -65,25 +67,38 @@ void complement_from(std::vector<Interval>& out, std::size_t base, TimeNs from, 
 
 }  // namespace
 
-void TimelineSet::append_blocked(EntityIndex x, std::string_view agent, TimeNs from,
-                                 TimeNs until, bool count_locks,
-                                 std::vector<Interval>& out) const {
-  const auto block = [&](TimeNs start, TimeNs end) {
-    start = std::max(start, from);
-    end = std::min(end, until);
-    if (start < end) out.push_back(Interval{start, end});
+void TimelineSet::Impl::append_blocked(const TimelineSet& set, EntityIndex x,
+                                       const BlockRule& rule, std::vector<Interval>& out,
+                                       std::vector<ShadowBlock>* shadows) {
+  const auto clip = [&](TimeNs start, TimeNs end) {
+    return Interval{std::max(start, rule.from), std::min(end, rule.until)};
   };
-  const Timeline& t = timelines_[x];
-  if (count_locks) {
-    for (const Lock& lock : t.locks) block(lock.window.start, lock.window.end);
+  const Timeline& t = set.timelines_[x];
+  if (rule.count_locks) {
+    for (const Lock& lock : t.locks) {
+      if (const Interval w = clip(lock.window.start, lock.window.end); w.valid()) out.push_back(w);
+    }
   }
   for (const Reservation& r : t.reservations) {
-    if (same_agent(r.agent, agent)) continue;
+    if (same_agent(r.agent, rule.agent)) continue;
+    // A real reservation on x conflicts with every step that writes on x; a shadow only
+    // with a step on its origin or on a member of its origin's conflict set (I1).
+    const bool real = r.origin == x;
+    if (!real && shadows == nullptr && x != rule.entity &&
+        !origins_conflict(set, r.origin, rule.entity)) {
+      continue;
+    }
     // Nobody may come before a holder: everything up to its end is taken. (Most
     // reservations' origins are not held at all: that is checked first, inline.)
-    const bool held = r.window.start > from && r.origin < held_.size() && held_[r.origin] &&
-                      Impl::is_held(*this, r);
-    block(held ? from : r.window.start, r.window.end);
+    const bool held = r.window.start > rule.from && r.origin < set.held_.size() &&
+                      set.held_[r.origin] && is_held(set, r);
+    const Interval w = clip(held ? rule.from : r.window.start, r.window.end);
+    if (!w.valid()) continue;
+    if (real || shadows == nullptr) {
+      out.push_back(w);
+    } else {
+      shadows->push_back(ShadowBlock{w, r.origin});
+    }
   }
 }
 
@@ -93,9 +108,10 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
   if (!owns(entity) || from >= until) return;
   // The blockers are collected at the end of `out` itself and turned into their complement.
   const std::size_t base = out.size();
-  append_blocked(entity, agent, from, until, count_locks, out);
+  const Impl::BlockRule rule{agent, entity, from, until, count_locks};
+  Impl::append_blocked(*this, entity, rule, out, nullptr);
   for (EntityIndex f : conflict_sets_[entity]) {
-    if (owns(f)) append_blocked(f, agent, from, until, count_locks, out);
+    if (owns(f)) Impl::append_blocked(*this, f, rule, out, nullptr);
   }
   complement_from(out, base, from, until);
 }
@@ -111,6 +127,7 @@ void FreeWindowQuery::start(std::string_view agent, TimeNs from, TimeNs until,
     generation_ = 1;
   }
   blocked_.clear();
+  shadows_.clear();
 }
 
 void TimelineSet::append_free_windows(EntityIndex entity, FreeWindowQuery& query,
@@ -121,20 +138,37 @@ void TimelineSet::append_free_windows(EntityIndex entity, FreeWindowQuery& query
     query.stamp_.assign(timelines_.size(), 0);
     query.first_.resize(timelines_.size());
     query.count_.resize(timelines_.size());
+    query.shadow_first_.resize(timelines_.size());
+    query.shadow_count_.resize(timelines_.size());
   }
   const std::size_t base = out.size();
+  // Per timeline, read once per query series: the locks and other agents' real
+  // reservations (merged; they block every step writing there) and the other agents'
+  // shadows with their origins (which block only steps on entities their origin
+  // conflicts with).
+  const auto read = [&](EntityIndex x) {
+    if (query.stamp_[x] == query.generation_) return;
+    query.stamp_[x] = query.generation_;
+    const std::size_t first = query.blocked_.size();
+    const std::size_t shadow_first = query.shadows_.size();
+    const Impl::BlockRule rule{query.agent_, x, query.from_, query.until_, query.count_locks_};
+    Impl::append_blocked(*this, x, rule, query.blocked_, &query.shadows_);
+    merge_from(query.blocked_, first);
+    query.first_[x] = static_cast<std::uint32_t>(first);
+    query.count_[x] = static_cast<std::uint32_t>(query.blocked_.size() - first);
+    query.shadow_first_[x] = static_cast<std::uint32_t>(shadow_first);
+    query.shadow_count_[x] = static_cast<std::uint32_t>(query.shadows_.size() - shadow_first);
+  };
   const auto add_blocked = [&](EntityIndex x) {
-    if (query.stamp_[x] != query.generation_) {
-      query.stamp_[x] = query.generation_;
-      const std::size_t first = query.blocked_.size();
-      append_blocked(x, query.agent_, query.from_, query.until_, query.count_locks_,
-                     query.blocked_);
-      merge_from(query.blocked_, first);
-      query.first_[x] = static_cast<std::uint32_t>(first);
-      query.count_[x] = static_cast<std::uint32_t>(query.blocked_.size() - first);
-    }
+    read(x);
     const auto begin = query.blocked_.begin() + query.first_[x];
     out.insert(out.end(), begin, begin + query.count_[x]);
+    const auto shadow_begin = query.shadows_.begin() + query.shadow_first_[x];
+    for (auto s = shadow_begin; s != shadow_begin + query.shadow_count_[x]; ++s) {
+      if (x == entity || Impl::origins_conflict(*this, s->origin, entity)) {
+        out.push_back(s->window);
+      }
+    }
   };
   add_blocked(entity);
   for (EntityIndex f : conflict_sets_[entity]) {

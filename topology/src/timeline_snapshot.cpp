@@ -111,26 +111,21 @@ class SnapshotCheck {
         return error(es, what + ": its route step is on this timeline twice");
       }
     }
-    // I1: in start order, each item must start after every other agent's item before it
-    // has ended; the latest end of two distinct agents is enough to know that.
+    // I1: in start order, each item must start after every item before it of another
+    // agent whose origin conflicts with its own (a real item's origin conflicts with all).
     std::vector<const Reservation*> order;
     for (const Reservation& r : es.reservations) order.push_back(&r);
     std::sort(order.begin(), order.end(), [](const Reservation* a, const Reservation* b) {
       return a->window.start < b->window.start;  // same-start items of two agents overlap
     });
-    const Reservation* latest = nullptr;        // the item ending last so far
-    const Reservation* latest_other = nullptr;  // ending last among other agents than latest's
-    for (const Reservation* r : order) {
-      const Reservation* blocker = latest && latest->agent != r->agent ? latest : latest_other;
-      if (blocker && r->window.start < blocker->window.end) {
-        return error(es, describe(*r) + " overlaps " + describe(*blocker) + " (I1)");
-      }
-      if (!latest || r->window.end > latest->window.end) {
-        if (latest && latest->agent != r->agent) latest_other = latest;
-        latest = r;
-      } else if (r->agent != latest->agent &&
-                 (!latest_other || r->window.end > latest_other->window.end)) {
-        latest_other = r;
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        const Reservation* before = order[j];
+        const Reservation* r = order[i];
+        if (before->agent != r->agent && r->window.start < before->window.end &&
+            (before->origin == r->origin || conflict(before->origin, r->origin))) {
+          return error(es, describe(*r) + " overlaps " + describe(*before) + " (I1)");
+        }
       }
     }
     return {};

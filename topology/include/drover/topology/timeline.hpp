@@ -3,14 +3,19 @@
 // the conflict set), when nobody may (locks), who is there now (allocation) and who waits.
 //
 // TimelineSet keeps the invariants of shared/DESIGN.md after every operation:
-//  I1 exclusive   reservations of different agents on one timeline never overlap; as
-//                 reserving e writes shadow reservations on every f in C(e), this makes
-//                 e and C(e) exclusive; at most one agent holds an allocation among them.
+//  I1 exclusive   reservations of different agents whose origins conflict (are equal or
+//                 in each other's conflict set) never overlap; as reserving e writes
+//                 shadow reservations on every f in C(e), each timeline is enough to check
+//                 this: on timeline x a real reservation conflicts with every other one,
+//                 two shadows only if their origins conflict (shadows of two entities
+//                 that do not conflict may overlap). At most one agent holds an
+//                 allocation among e and C(e).
 //  I2 order       an agent is granted e only when no other agent's reservation (real or
 //                 shadow) on e precedes its own; waiting agents learn their queue position.
 //  I3 delay keeps order   a delay shifts the agent's remaining reservations and, where
-//                 they run into later reservations of others, those too, transitively;
-//                 the order on every timeline is unchanged; every agent moved is reported.
+//                 they run into later conflicting reservations of others, those too,
+//                 transitively; the order of conflicting reservations on every timeline is
+//                 unchanged; every agent moved is reported.
 //  I4 locks       a lock blocks new reservations on its entity (and, through shadows and
 //                 free-window queries, on its conflict set) during its interval; owners of
 //                 reservations it hits are reported; allocations are never revoked by it.
@@ -182,6 +187,13 @@ struct TimelineSnapshot {
   friend bool operator==(const TimelineSnapshot&, const TimelineSnapshot&) = default;
 };
 
+/// A shadow reservation as a free-window query sees it: when it blocks, and which entity it
+/// stands for (it blocks only steps on entities that conflict with that one).
+struct ShadowBlock {
+  Interval window;
+  EntityIndex origin = kNoEntity;
+};
+
 /// Memory for many free-window queries of one agent on one TimelineSet that does not change
 /// meanwhile (a planner's search): what blocks the agent on each timeline is read once and
 /// reused for every entity whose windows depend on it. See
@@ -200,7 +212,9 @@ class FreeWindowQuery {
   bool count_locks_ = true;
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> stamp_, first_, count_;  // per timeline, into blocked_
-  std::vector<Interval> blocked_;                     // sorted, disjoint, per timeline
+  std::vector<Interval> blocked_;  // locks and real reservations: sorted, disjoint, per timeline
+  std::vector<std::uint32_t> shadow_first_, shadow_count_;  // per timeline, into shadows_
+  std::vector<ShadowBlock> shadows_;  // other agents' shadows, per timeline
 };
 
 /// The timelines of a set of entities (all of a topology, or one partition's).
@@ -234,8 +248,10 @@ class TimelineSet {
   /// agents' reservations on its timeline and of locks on it and on C(entity). Sorted,
   /// disjoint, maximal. The agent's own reservations never block it.
   /// As a step on `entity` also writes shadows on C(entity), other agents' reservations
-  /// on the owned members of C(entity) block too, and so does everything up to the end of
-  /// another agent's allocated reservation there (nobody may come before a holder): a
+  /// on the owned members of C(entity) block too when their origin conflicts with
+  /// `entity` (real ones always; shadows of `entity` or of a member of C(entity)), and so
+  /// does everything up to the end of such a reservation that is allocated (nobody may
+  /// come before a holder): a
   /// step whose window lies in one of these windows is accepted by prepare (versions
   /// aside), as far as the owned entities go. Empty for an entity not owned.
   std::vector<Interval> free_windows(EntityIndex entity, const AgentId& agent, TimeNs from,
@@ -255,11 +271,12 @@ class TimelineSet {
                            std::vector<Interval>& out) const;
 
   /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
-  /// overlaps another agent's reservation or a lock, or if an expected version moved;
+  /// overlaps a lock or another agent's reservation whose origin conflicts with the
+  /// item's (I1), or if an expected version moved;
   /// invalid_argument for an empty set, a bad window or mixed agents/routes; not_found for
   /// an entity not owned. Held items block others until commit, abort or expiry.
   /// Also conflict: an item that would come before another agent's allocated reservation
-  /// on its timeline (a holder is never overtaken), or a step of the route that already
+  /// with a conflicting origin on its timeline (a holder is never overtaken), or a step of the route that already
   /// has reservations here. invalid_argument too: an empty agent id, a shadow that is not
   /// on a member of its origin's conflict set, items of one step with different origins
   /// or windows, the same item twice. Checks run in that order of codes: every
@@ -313,13 +330,15 @@ class TimelineSet {
   /// Delay of `by` (> 0) for `agent`'s route from its step on `entity` on: that step's
   /// window ends `by` later and the later steps move by `by`; every later reservation of
   /// another agent they run into moves as far as needed, transitively (I3). Open ends stay
-  /// open. not_found if the agent has no reservation of the route on the entity.
+  /// open. Only reservations whose origins conflict push each other (as in I1).
+  /// not_found if the agent has no reservation of the route on the entity.
   /// The step is the route's real reservation on `entity`, else its shadow there (the
   /// owner of a neighbour's shadows delays them this way). A pushed route's step that
   /// would start before its blocker ends starts when it ends: the route waits that much
   /// longer at the previous step (its first step moves whole) and moves on from there,
   /// each route by no more than needed. Allocations and waiting requests are unchanged
-  /// (the order on every timeline is). invalid_argument if a time would pass kForever.
+  /// (the order of conflicting reservations on every timeline is). invalid_argument if a
+  /// time would pass kForever.
   Result<DelayReport> delay(const AgentId& agent, RouteId route, EntityIndex entity,
                             DurationNs by);
 
@@ -349,7 +368,7 @@ class TimelineSet {
   ///         inconsistent: an entity out of range, not owned or given twice; a reservation
   ///         that is prepared, has an empty agent or window, sits on another timeline, is a
   ///         shadow of an entity it does not conflict with, repeats its step, or overlaps
-  ///         another agent's (I1); a real reservation without its shadow on an owned member
+  ///         another agent's with a conflicting origin (I1); a real reservation without its shadow on an owned member
   ///         of its conflict set, or a shadow without its real reservation on an owned
   ///         origin (same window); a holder without its committed real reservation, with
   ///         another agent's reservation before it (I2), or next to another agent holding
@@ -360,11 +379,6 @@ class TimelineSet {
 
  private:
   struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
-
-  /// Appends what keeps `agent` from writing on timeline x during [from, until) (clipped,
-  /// in no particular order): the free-window rule, in timeline_query.cpp.
-  void append_blocked(EntityIndex x, std::string_view agent, TimeNs from, TimeNs until,
-                      bool count_locks, std::vector<Interval>& out) const;
 
   /// Names one reservation of the set within a prepared set's (agent, route). Prepared
   /// sets remember keys, not copies, because a delay may move held items before commit.
