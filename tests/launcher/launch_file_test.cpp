@@ -37,7 +37,7 @@ std::string problems_of(const std::string& text) {
 /// A loop launch file with `agents` as its agent list.
 std::string loop_file(const std::string& agents) {
   return R"({"domain": 226, "time_factor": 5, "epoch": 1000, "topology": "topologies/loop.json",
-            "vehicle_profiles": {"slow": {"max_speed": 0.5, "load_duration": 2}}, "agents": [)" +
+            "vehicle_profiles": {"slow": {"max_speed": 0.5, "load_duration": 2, "length": 0.8}}, "agents": [)" +
          agents + "]}";
 }
 
@@ -46,7 +46,7 @@ TEST(LaunchFile, GoodFileBecomesCommandLines) {
       {"kind": "topology", "db": "loop.db", "restart": "on-failure", "max_restarts": 2},
       {"kind": "routing", "id": "routing-1"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "profile": "slow", "loaded": true},
-      {"kind": "logical", "vehicle": "V1"},
+      {"kind": "logical", "vehicle": "V1", "profile": "slow", "lookahead": 3},
       {"kind": "load-generator", "seed": 7, "stations": ["station", "parking"]})"));
   ASSERT_TRUE(parsed.has_value()) << parsed.error().front().where << ": " << parsed.error().front().what;
   EXPECT_EQ(parsed->domain_id, 226u);
@@ -71,7 +71,14 @@ TEST(LaunchFile, GoodFileBecomesCommandLines) {
   EXPECT_EQ(ran.options, (std::vector<std::string>{"--agent-id", "ran-V1", "--id", "V1", "--topology", topology,
                                                    "--at", "south-west", "--loaded", "--load-duration", "2",
                                                    "--max-speed", "0.5"}));
-  EXPECT_EQ(parsed->agents[3].id, "V1");
+  const auto& logical = parsed->agents[3];
+  EXPECT_EQ(logical.id, "V1");
+  EXPECT_EQ(logical.options, (std::vector<std::string>{"--id", "V1", "--topology", topology, "--lookahead", "3",
+                                                       "--vehicle", "/state/V1.vehicle.json"}));
+  // The logical agent plans with the profile's speeds: its file is written before it starts.
+  ASSERT_EQ(logical.files.size(), 1u);
+  EXPECT_EQ(logical.files[0].first, "/state/V1.vehicle.json");
+  EXPECT_EQ(logical.files[0].second, "{\"id\":\"V1\",\"length\":0.8,\"max_speed\":0.5}\n");
   EXPECT_EQ(parsed->agents[4].options,
             (std::vector<std::string>{"--id", "load-generator", "--topology", topology, "--seed", "7", "--station",
                                       "station", "--station", "parking"}));

@@ -1,5 +1,6 @@
 #include "drover/launcher/launch_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -36,8 +37,11 @@ struct FieldRule {
   FieldType type;
 };
 
-/// The fields a vehicle profile may set, and the ran-sim options they become.
+/// The fields a vehicle profile may set, and the ran-sim options they become (none: the
+/// field is for the logical agent only).
 const std::vector<FieldRule> kProfileFields{
+    {"length", "", FieldType::positive_number},
+    {"width", "", FieldType::positive_number},
     {"max_speed", "--max-speed", FieldType::positive_number},
     {"acceleration", "--acceleration", FieldType::positive_number},
     {"deceleration", "--deceleration", FieldType::positive_number},
@@ -50,13 +54,18 @@ const std::vector<FieldRule> kProfileFields{
     {"unload_duration", "--unload-duration", FieldType::number},
 };
 
+/// The profile fields a logical agent plans with (its --vehicle file, carp's format), so
+/// that it plans with the speeds its simulated vehicle drives at.
+const std::vector<std::string_view> kLogicalProfileFields{"max_speed", "acceleration", "deceleration",
+                                                          "length", "width"};
+
 struct KindRules {
   AgentKind kind;
   std::string_view name;
   std::string_view subcommand;
   std::string_view id_option;       ///< the option that sets the agent id
   std::string_view vehicle_option;  ///< the option that sets the vehicle id; empty: none
-  bool takes_profile;               ///< ran-sim: a vehicle profile's fields become options
+  bool takes_profile;               ///< ran-sim, logical: may name a vehicle profile
   bool takes_topology;              ///< gets --topology FILE
   std::vector<FieldRule> fields;    ///< besides kind, id, vehicle, restart, max_restarts
 };
@@ -75,8 +84,15 @@ const std::vector<KindRules>& kind_rules() {
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::routing, "routing", "routing-agent", "--id", "", false, false,
        {{"log_level", "--log-level", FieldType::text}}},
-      {AgentKind::logical, "logical", "logical-agent", "--id", "", false, false,
-       {{"log_level", "--log-level", FieldType::text}}},
+      {AgentKind::logical, "logical", "logical-agent", "--id", "", true, true,
+       {{"lookahead", "--lookahead", FieldType::count},
+        {"delay_threshold", "--delay-threshold", FieldType::positive_number},
+        {"park_after", "--park-after", FieldType::number},
+        {"charge_below", "--charge-below", FieldType::number},
+        {"charge_to", "--charge-to", FieldType::number},
+        {"error_limit", "--error-limit", FieldType::positive_number},
+        {"route_limit", "--route-limit", FieldType::number},
+        {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
        {{"seed", "--seed", FieldType::count},
         {"stations", "--station", FieldType::vertex_list},
@@ -237,7 +253,8 @@ class LaunchFileParser {
         checker_.problem(where, "must be an object");
         continue;
       }
-      std::vector<std::string> options;
+      Profile parsed;
+      parsed.logical = Json::object();
       for (const auto& [key, value] : profile.items()) {
         const FieldRule* rule = nullptr;
         for (const auto& candidate : kProfileFields) {
@@ -247,9 +264,15 @@ class LaunchFileParser {
           checker_.problem(join(where, key), "unknown field (expected one of: " + profile_field_list() + ")");
           continue;
         }
-        add_option(*rule, value, join(where, key), options);
+        std::vector<std::string> checked;
+        add_option(*rule, value, join(where, key), checked);
+        if (checked.empty()) continue;  // reported
+        if (!rule->option.empty()) parsed.ran_options.insert(parsed.ran_options.end(), checked.begin(), checked.end());
+        if (std::find(kLogicalProfileFields.begin(), kLogicalProfileFields.end(), key) != kLogicalProfileFields.end()) {
+          parsed.logical[key] = value;
+        }
       }
-      profiles_[name] = std::move(options);
+      profiles_[name] = std::move(parsed);
     }
   }
 
@@ -277,6 +300,7 @@ class LaunchFileParser {
     }
     AgentEntry agent;
     agent.kind = rules->kind;
+    std::optional<Json> logical_profile;
     const bool has_vehicle = rules->kind == AgentKind::ran_sim || rules->kind == AgentKind::logical;
     for (const auto& [key, value] : entry.items()) {
       const std::string field = join(where, key);
@@ -301,8 +325,11 @@ class LaunchFileParser {
         const auto profile = value.is_string() ? profiles_.find(value.get<std::string>()) : profiles_.end();
         if (profile == profiles_.end()) {
           checker_.problem(field, "names no entry of vehicle_profiles");
+        } else if (rules->kind == AgentKind::ran_sim) {
+          agent.options.insert(agent.options.end(), profile->second.ran_options.begin(),
+                               profile->second.ran_options.end());
         } else {
-          agent.options.insert(agent.options.end(), profile->second.begin(), profile->second.end());
+          logical_profile = profile->second.logical;
         }
       } else {
         const FieldRule* rule = nullptr;
@@ -336,6 +363,13 @@ class LaunchFileParser {
     }
     if (rules->takes_topology) identity.insert(identity.end(), {"--topology", file_.topology_file.string()});
     agent.options.insert(agent.options.begin(), identity.begin(), identity.end());
+    if (logical_profile && !agent.vehicle.empty()) {
+      // The logical agent reads its profile from a file: written into the state directory.
+      (*logical_profile)["id"] = agent.vehicle;
+      const auto profile_file = (state_dir_ / (agent.vehicle + ".vehicle.json")).lexically_normal();
+      agent.files.push_back({profile_file, logical_profile->dump() + "\n"});
+      agent.options.insert(agent.options.end(), {"--vehicle", profile_file.string()});
+    }
     starts_.push_back(entry.contains("at") && entry["at"].is_string() ? entry["at"].get<std::string>() : "");
     wheres_.push_back(where);
     partitions_.push_back(entry.contains("partition") && entry["partition"].is_string()
@@ -505,7 +539,11 @@ class LaunchFileParser {
   LaunchFile file_;
   Checker checker_;
   std::optional<topology::Topology> topology_;
-  std::map<std::string, std::vector<std::string>> profiles_;
+  struct Profile {
+    std::vector<std::string> ran_options;  ///< for ran-sim
+    Json logical;                          ///< for the logical agent's --vehicle file
+  };
+  std::map<std::string, Profile> profiles_;
   // Per agent entry, parallel to file_.agents: its start vertex, its place, its partition.
   std::vector<std::string> starts_;
   std::vector<std::string> wheres_;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "drover/common/clock.hpp"
@@ -44,6 +45,9 @@ struct AgentEntry {
   /// the kind takes one, then the entry's fields and its vehicle profile. The launcher
   /// adds the domain id and the clock.
   std::vector<std::string> options;
+  /// Files to write before the agent starts (path, content): a logical agent's vehicle
+  /// profile, made from the launch file's profile, lives in the state directory.
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
 };
 
 /// A parsed and checked launch file.
