@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <iterator>
 #include <set>
 #include <tuple>
 
@@ -34,6 +35,15 @@ void send_error(dds::ReplyHandle<Rep>& handle, const Error& error) {
 void send_status(dds::ReplyHandle<msg::StatusReply>& handle, const Status& status) {
   if (!status) return send_error(handle, status.error());
   send_reply(handle, msg::StatusReply{});
+}
+
+/// The real reservation of (agent, route, step) on `timeline`, if it is there.
+std::optional<topology::Reservation> find_real(const topology::Timeline& timeline, const std::string& agent,
+                                               topology::RouteId route, std::uint32_t step) {
+  for (const auto& item : timeline.reservations) {
+    if (!item.shadow() && item.agent == agent && item.route == route && item.step == step) return item;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -108,6 +118,9 @@ Status TopologyAgent::start() {
                                                              dds::TopicQos::events());
   if (!notices) return unexpected(notices.error());
   notice_writer_ = std::move(*notices);
+  auto events = dds::Writer<msg::TopologyEvent>::create(*participant_, kEventTopic, dds::TopicQos::events());
+  if (!events) return unexpected(events.error());
+  event_writer_ = std::move(*events);
 
   {
     std::lock_guard lock(mutex_);
@@ -224,7 +237,10 @@ void TopologyAgent::on_prepare(const msg::ReservePrepareRequest& request,
   }
   auto prepared = timelines_.prepare(items, expected, request.expires_at());
   if (!prepared) return send_error(reply, prepared.error());
-  prepared_[*prepared] = PreparedRoute{request.agent(), request.route()};
+  PreparedRoute held{request.agent(), request.route(), {}};
+  std::copy_if(items.begin(), items.end(), std::back_inserter(held.real_items),
+               [](const topology::Reservation& item) { return !item.shadow(); });
+  prepared_[*prepared] = std::move(held);
   if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
   msg::ReservePrepareReply out;
   out.prepare_id(*prepared);
@@ -243,8 +259,16 @@ void TopologyAgent::on_commit(const msg::ReserveCommitRequest& request, StatusHa
   std::lock_guard lock(mutex_);
   auto committed = timelines_.commit(request.prepare_id());
   if (committed) {
-    prepared_.erase(request.prepare_id());
-    committed = after_change(timelines_.take_grants());
+    auto held = prepared_.extract(request.prepare_id());
+    std::vector<msg::TopologyEvent> events;
+    if (held) {
+      // Windows as they are now (a delay may have moved held items before the commit).
+      for (const auto& item : held.mapped().real_items) {
+        auto now = find_real(timelines_.timeline(item.entity), item.agent, item.route, item.step);
+        if (now) events.push_back(make_event(msg::EVENT_RESERVED, *now));
+      }
+    }
+    committed = after_change(timelines_.take_grants(), std::move(events));
   }
   send_status(reply, committed);
 }
@@ -253,8 +277,15 @@ void TopologyAgent::on_abort(const msg::ReserveAbortRequest& request, StatusHand
   std::lock_guard lock(mutex_);
   auto aborted = timelines_.abort(request.prepare_id());
   if (aborted) {
-    prepared_.erase(request.prepare_id());
-    aborted = after_change(timelines_.take_grants());
+    auto held = prepared_.extract(request.prepare_id());
+    std::vector<msg::TopologyEvent> events;
+    if (held) {
+      events.emplace_back();
+      events.back().kind(msg::EVENT_ABORTED);
+      events.back().agent(held.mapped().agent);
+      events.back().route(held.mapped().route);
+    }
+    aborted = after_change(timelines_.take_grants(), std::move(events));
   }
   send_status(reply, aborted);
 }
@@ -263,9 +294,13 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
   std::lock_guard lock(mutex_);
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
+  const bool held_before = timelines_.timeline(*entity).holder == request.agent();
   auto allocation = timelines_.allocate(request.agent(), *entity);
   if (!allocation) return send_error(reply, allocation.error());
-  if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  // A grant made now is reported like a deferred one (NOTICE_ALLOCATION_GRANTED aside).
+  std::vector<topology::Grant> granted_now;
+  if (allocation->granted && !held_before) granted_now.push_back(topology::Grant{request.agent(), *entity});
+  if (auto saved = after_change(granted_now, {}, false); !saved) return send_error(reply, saved.error());
   if (allocation->granted || !request.wait()) {
     msg::AllocateReply out;
     out.granted(allocation->granted);
@@ -281,9 +316,14 @@ void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle 
   std::lock_guard lock(mutex_);
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
+  const auto step = timelines_.allocated_step(*entity);
+  std::optional<topology::Reservation> held;
+  if (step) held = find_real(timelines_.timeline(*entity), request.agent(), step->route, step->step);
   auto grants = timelines_.release(request.agent(), *entity);
   if (!grants) return send_error(reply, grants.error());
-  send_status(reply, after_change(*grants));
+  std::vector<msg::TopologyEvent> events;
+  if (held) events.push_back(make_event(msg::EVENT_RELEASED, *held));
+  send_status(reply, after_change(*grants, std::move(events)));
 }
 
 void TopologyAgent::on_lock(const msg::LockRequest& request, dds::ReplyHandle<msg::LockReply> reply) {
@@ -296,6 +336,14 @@ void TopologyAgent::on_lock(const msg::LockRequest& request, dds::ReplyHandle<ms
   spdlog::info("lock {} on '{}' by '{}': {} ({} reservations hit)", lock_id, request.entity(),
                request.operator_id(), request.reason(), report->hit.size());
   if (auto saved = after_change({}); !saved) return send_error(reply, saved.error());
+  msg::TopologyEvent event;
+  event.kind(msg::EVENT_LOCKED);
+  event.agent(request.operator_id());
+  event.entity(request.entity());
+  event.window(request.window());
+  event.lock_id(lock_id);
+  event.reason(request.reason());
+  record(std::move(event));
   msg::LockReply out;
   out.lock_id(lock_id);
   for (const auto& hit : report->hit) {
@@ -318,12 +366,30 @@ void TopologyAgent::on_unlock(const msg::UnlockRequest& request, StatusHandle re
                                                              agent_id() + "' (its locks are '" + prefix +
                                                              "<number>')"});
   }
+  std::optional<topology::Lock> removed;
+  for (topology::EntityIndex entity = 0; entity < topology_.entity_count() && !removed; ++entity) {
+    if (!timelines_.owns(entity)) continue;
+    for (const auto& entry : timelines_.timeline(entity).locks) {
+      if (entry.id == number) removed = entry;
+    }
+  }
   auto unlocked = timelines_.unlock(number);
   if (!unlocked) {
     return send_error(reply, Error{ErrorCode::not_found, "unknown lock '" + id + "'"});
   }
   spdlog::info("lock {} removed", id);
-  send_status(reply, after_change({}));
+  auto saved = after_change({});
+  if (saved && removed) {
+    msg::TopologyEvent event;
+    event.kind(msg::EVENT_UNLOCKED);
+    event.agent(removed->operator_id);
+    event.entity(topology_.id(removed->entity));
+    event.window(to_wire(removed->window));
+    event.lock_id(id);
+    event.reason(removed->reason);
+    record(std::move(event));
+  }
+  send_status(reply, saved);
 }
 
 void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<msg::DelayReply> reply) {
@@ -345,14 +411,27 @@ void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<
     wire_shift.from_step(shift.from_step);
     wire_shift.by(shift.by);
     out.shifts().push_back(wire_shift);
+    // Each agent is told about its own route: where it first moved here, and the new window.
     msg::ReservationNotice notice;
     notice.agent(shift.agent);
     notice.kind(msg::NOTICE_SHIFTED);
     notice.route(shift.route);
-    notice.entity(request.entity());
     notice.shift(shift.by);
     notice.from_step(shift.from_step);
+    msg::TopologyEvent event;
+    event.kind(msg::EVENT_DELAYED);
+    event.agent(shift.agent);
+    event.route(shift.route);
+    event.step(shift.from_step);
+    event.shift(shift.by);
+    if (auto moved = first_moved(shift.agent, shift.route, shift.from_step)) {
+      notice.entity(topology_.id(moved->entity));
+      notice.window(to_wire(moved->window));
+      event.entity(notice.entity());
+      event.window(notice.window());
+    }
     notify(std::move(notice));
+    record(std::move(event));
   }
   for (const auto& hit : report->hit_locks) {
     out.hit_locks().push_back(to_wire(topology_, hit));
@@ -370,7 +449,11 @@ void TopologyAgent::on_cancel_route(const msg::CancelRouteRequest& request, Stat
   std::erase_if(prepared_, [&](const auto& entry) {
     return entry.second.agent == request.agent() && entry.second.route == request.route();
   });
-  send_status(reply, after_change(*grants));
+  msg::TopologyEvent event;
+  event.kind(msg::EVENT_CANCELLED);
+  event.agent(request.agent());
+  event.route(request.route());
+  send_status(reply, after_change(*grants, {std::move(event)}));
 }
 
 void TopologyAgent::run_expiry() {
@@ -378,6 +461,7 @@ void TopologyAgent::run_expiry() {
   while (!expiry_wake_.wait_for(lock, options_.expiry_period, [this] { return stopping_; })) {
     const auto expired = timelines_.expire(clock_.now());
     if (expired.empty()) continue;
+    std::vector<msg::TopologyEvent> events;
     for (auto id : expired) {
       auto found = prepared_.find(id);
       if (found == prepared_.end()) continue;
@@ -387,13 +471,18 @@ void TopologyAgent::run_expiry() {
       notice.kind(msg::NOTICE_PREPARE_EXPIRED);
       notice.route(found->second.route);
       notify(std::move(notice));
+      events.emplace_back();
+      events.back().kind(msg::EVENT_EXPIRED);
+      events.back().agent(found->second.agent);
+      events.back().route(found->second.route);
       prepared_.erase(found);
     }
-    if (!after_change(timelines_.take_grants())) return;
+    if (!after_change(timelines_.take_grants(), std::move(events))) return;
   }
 }
 
-Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants) {
+Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants,
+                                  std::vector<msg::TopologyEvent> events, bool notify_grants) {
   std::vector<topology::EntityIndex> changed;
   for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
     if (timelines_.owns(entity) && timelines_.timeline(entity).version != published_versions_[entity]) {
@@ -417,7 +506,14 @@ Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants) {
     }
     published_versions_[entity] = timeline.version;
   }
+  for (auto& event : events) record(std::move(event));
   for (const auto& grant : grants) {
+    if (const auto step = timelines_.allocated_step(grant.entity)) {
+      if (auto held = find_real(timelines_.timeline(grant.entity), grant.agent, step->route, step->step)) {
+        record(make_event(msg::EVENT_ALLOCATED, *held));
+      }
+    }
+    if (!notify_grants) continue;
     msg::ReservationNotice notice;
     notice.agent(grant.agent);
     notice.kind(msg::NOTICE_ALLOCATION_GRANTED);
@@ -463,6 +559,44 @@ void TopologyAgent::notify_hit(const topology::Reservation& hit, const std::stri
   notice.lock_id(lock_id);
   notice.window(to_wire(hit.window));
   notify(std::move(notice));
+}
+
+void TopologyAgent::record(msg::TopologyEvent event) {
+  event.time(clock_.now());
+  event.source(agent_id());
+  event.serial(++event_serial_);
+  if (auto written = event_writer_->write(event); !written) {
+    spdlog::error("event {} not published: {}", event.serial(), written.error().message);
+  }
+}
+
+msg::TopologyEvent TopologyAgent::make_event(msg::TopologyEventKind kind, const topology::Reservation& item) const {
+  msg::TopologyEvent event;
+  event.kind(kind);
+  event.agent(item.agent);
+  event.route(item.route);
+  event.step(item.step);
+  event.entity(topology_.id(item.entity));
+  event.window(to_wire(item.window));
+  return event;
+}
+
+std::optional<topology::Reservation> TopologyAgent::first_moved(const topology::AgentId& agent,
+                                                                topology::RouteId route,
+                                                                std::uint32_t from_step) const {
+  std::optional<topology::Reservation> best;
+  auto better = [&](const topology::Reservation& item) {
+    if (!best) return true;
+    if (item.step != best->step) return item.step < best->step;
+    return best->shadow() && !item.shadow();
+  };
+  for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
+    if (!timelines_.owns(entity)) continue;
+    for (const auto& item : timelines_.timeline(entity).reservations) {
+      if (item.agent == agent && item.route == route && item.step >= from_step && better(item)) best = item;
+    }
+  }
+  return best;
 }
 
 }  // namespace drover::topology_agent

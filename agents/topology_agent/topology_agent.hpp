@@ -29,12 +29,18 @@
 #include "drover/topology/timeline.hpp"
 #include "topology.h"
 
+namespace drover::dds {
+DROVER_DDS_MESSAGE(TopologyEvent);
+}  // namespace drover::dds
+
 namespace drover::topology_agent {
 
 /// Topics and services (area "topology") of the topology agents.
 inline constexpr const char* kEntityTopic = "drover/topology/entity";
 inline constexpr const char* kTimelineTopic = "drover/topology/timeline";
 inline constexpr const char* kNoticeTopic = "drover/topology/notices";
+/// What the agents changed (TopologyEvent), for traces; events QoS.
+inline constexpr const char* kEventTopic = "drover/topology/events";
 inline constexpr const char* kServiceArea = "topology";
 
 struct TopologyAgentOptions {
@@ -101,12 +107,25 @@ class TopologyAgent {
   /// Saves every owned timeline whose version differs from the one last published to the
   /// journal, then republishes them, answers queued allocation requests that were granted
   /// or withdrawn, and sends a NOTICE_ALLOCATION_GRANTED for every grant the timelines
-  /// made. \return the journal's error when the save failed: then nothing is published,
+  /// made (`grants`). \return the journal's error when the save failed: then nothing is published,
   /// the operation must not be acknowledged, and the agent shuts down (its memory is
   /// ahead of its journal; a restart continues from the journal).
-  Status after_change(const std::vector<topology::Grant>& grants);
+  /// After the save, `events` (what the operation did) are published, then an
+  /// EVENT_ALLOCATED for every grant; notify_grants false leaves out the grants' notices
+  /// (the requester learns it from the reply).
+  Status after_change(const std::vector<topology::Grant>& grants, std::vector<msg::TopologyEvent> events = {},
+                      bool notify_grants = true);
   void notify(msg::ReservationNotice notice);
   void notify_hit(const topology::Reservation& hit, const std::string& lock_id);
+  /// Publishes `event` on kEventTopic with its time, source and sequence number filled in.
+  void record(msg::TopologyEvent event);
+  /// An event of `kind` about `item` (agent, route, step, entity, window), not yet published.
+  msg::TopologyEvent make_event(msg::TopologyEventKind kind, const topology::Reservation& item) const;
+  /// The reservation of (agent, route) on the owned entities from which a delay moved it:
+  /// its real reservation of the lowest step >= from_step here, else its shadow of that
+  /// step; nullopt when none is left here.
+  std::optional<topology::Reservation> first_moved(const topology::AgentId& agent, topology::RouteId route,
+                                                   std::uint32_t from_step) const;
 
   const topology::Topology topology_;
   const SharedClock clock_;
@@ -118,6 +137,8 @@ class TopologyAgent {
   std::unique_ptr<dds::Writer<msg::EntityDescription>> description_writer_;
   std::unique_ptr<dds::Writer<msg::TimelineState>> timeline_writer_;
   std::unique_ptr<dds::Writer<msg::ReservationNotice>> notice_writer_;
+  std::unique_ptr<dds::Writer<msg::TopologyEvent>> event_writer_;
+  std::uint64_t event_serial_ = 0;
   std::unique_ptr<dds::HeartbeatPublisher> heartbeat_;
 
   mutable std::mutex mutex_;
@@ -127,6 +148,7 @@ class TopologyAgent {
   struct PreparedRoute {
     std::string agent;
     topology::RouteId route = 0;
+    std::vector<topology::Reservation> real_items;  // its real reservations, as prepared
   };
   std::map<topology::PrepareId, PreparedRoute> prepared_;  // to tell owners of expired holds
   /// Allocation requests with wait = true that are queued: answered when granted.

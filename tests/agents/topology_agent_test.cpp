@@ -146,11 +146,24 @@ class TopologyAgentTest : public ::testing::Test {
         },
         dds::ReaderOptions{dds::TopicQos::events(), {}, {}});
     ASSERT_TRUE(notices.has_value());
+    // Notices and events are VOLATILE: what is sent before a reader matched is not seen.
+    ASSERT_TRUE((*notices)->wait_for_writers(agents_.size(), kDiscoveryTimeout));
     // Notices are events (VOLATILE): one sent before the match would be lost.
     ASSERT_TRUE((*notices)->wait_for_writers(agents_.size(), kDiscoveryTimeout));
     readers_.push_back(std::shared_ptr<void>(std::move(*timelines)));
     readers_.push_back(std::shared_ptr<void>(std::move(*descriptions)));
     readers_.push_back(std::shared_ptr<void>(std::move(*notices)));
+    auto events = dds::Reader<msg::TopologyEvent>::create(
+        *participant_, topology_agent::kEventTopic,
+        [this](const msg::TopologyEvent& event) {
+          std::lock_guard lock(mutex_);
+          events_.push_back(event);
+          changed_.notify_all();
+        },
+        dds::ReaderOptions{dds::TopicQos::events(), {}, {}});
+    ASSERT_TRUE(events.has_value());
+    ASSERT_TRUE((*events)->wait_for_writers(agents_.size(), kDiscoveryTimeout));
+    readers_.push_back(std::shared_ptr<void>(std::move(*events)));
   }
 
   /// Waits until `condition` (called with the mutex held) holds. \return whether it did.
@@ -284,6 +297,7 @@ class TopologyAgentTest : public ::testing::Test {
   std::map<std::string, msg::TimelineState> timelines_;
   std::map<std::string, msg::EntityDescription> descriptions_;
   std::vector<msg::ReservationNotice> notices_;
+  std::vector<msg::TopologyEvent> events_;
 };
 
 TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingPrepareChangesNothing) {
@@ -452,19 +466,70 @@ TEST_F(TopologyAgentTest, DelayShiftsThePushedRouteAndNotifiesEveryAffectedAgent
   ASSERT_EQ(delayed->shifts().size(), 2u);
   EXPECT_EQ(delayed->shifts()[0].agent(), "v1");
   EXPECT_EQ(delayed->shifts()[1].agent(), "v2");
+  // Each agent is told about its own route: its first moved step, entity and new window.
   EXPECT_TRUE(wait_until([&] {
     bool v1 = false, v2 = false;
     for (const auto& notice : notices_) {
-      if (notice.kind() != msg::NOTICE_SHIFTED) continue;
-      v1 = v1 || notice.agent() == "v1";
-      v2 = v2 || (notice.agent() == "v2" && notice.shift() == 500);
+      if (notice.kind() != msg::NOTICE_SHIFTED || notice.route() != 1 || notice.from_step() != 0 ||
+          notice.entity() != "a" || notice.shift() != 500) {
+        continue;
+      }
+      v1 = v1 || (notice.agent() == "v1" && notice.window().start() == 1000 && notice.window().end() == 2500);
+      v2 = v2 || (notice.agent() == "v2" && notice.window().start() == 2500 && notice.window().end() == 3500);
     }
     return v1 && v2;
-  }));
+  })) << "NOTICE_SHIFTED to v1 on a [1000, 2500) and to v2 on a [2500, 3500)";
   EXPECT_TRUE(wait_until([&] {
     const auto& reservations = timelines_["a"].reservations();
     return reservations.size() == 2 && reservations[1].agent() == "v2" && reservations[1].window().start() == 2500;
   }));
+}
+
+TEST_F(TopologyAgentTest, EveryReservationAllocationAndReleaseIsPublishedAsAnEvent) {
+  start_agent(170);
+  connect(170);
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  reserve("v2", 5, {{"a", {3000, 4000}}});
+  EXPECT_TRUE(allocate("v1", "a", false).granted());
+  auto waiting = std::async(std::launch::async, [this] { return allocate("v2", "a", true); });
+  ASSERT_TRUE(wait_until([&] { return timelines_["a"].waiting() == std::vector<std::string>{"v2"}; }));
+  EXPECT_EQ(release("v1", "a").error().code(), msg::ERROR_NONE);
+  EXPECT_TRUE(waiting.get().granted());
+  const auto locked = lock("d", 0, 500);
+
+  struct Expected {
+    msg::TopologyEventKind kind;
+    std::string agent;
+    topology::RouteId route;
+    std::string entity;
+    TimeNs start, end;
+  };
+  const std::vector<Expected> expected{{msg::EVENT_RESERVED, "v1", 1, "a", 1000, 2000},
+                                       {msg::EVENT_RESERVED, "v2", 5, "a", 3000, 4000},
+                                       {msg::EVENT_ALLOCATED, "v1", 1, "a", 1000, 2000},
+                                       {msg::EVENT_RELEASED, "v1", 1, "a", 1000, 2000},
+                                       {msg::EVENT_ALLOCATED, "v2", 5, "a", 3000, 4000},
+                                       {msg::EVENT_LOCKED, "operator-1", 0, "d", 0, 500}};
+  ASSERT_TRUE(wait_until([&] { return events_.size() >= expected.size(); }));
+  std::lock_guard guard(mutex_);
+  ASSERT_EQ(events_.size(), expected.size()) << "the shadows on a-b make no events of their own";
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const auto& event = events_[i];
+    SCOPED_TRACE("event " + std::to_string(i));
+    EXPECT_EQ(event.kind(), expected[i].kind);
+    EXPECT_EQ(event.agent(), expected[i].agent);
+    EXPECT_EQ(event.route(), expected[i].route);
+    EXPECT_EQ(event.entity(), expected[i].entity);
+    EXPECT_EQ(event.window().start(), expected[i].start);
+    EXPECT_EQ(event.window().end(), expected[i].end);
+    EXPECT_EQ(event.source(), "topology");
+    EXPECT_EQ(event.serial(), i + 1);
+    if (i > 0) {
+      EXPECT_GE(event.time(), events_[i - 1].time());
+    }
+  }
+  EXPECT_EQ(events_.back().lock_id(), locked.lock_id());
+  EXPECT_EQ(events_.back().reason(), "spilled oil");
 }
 
 TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
