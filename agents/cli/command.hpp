@@ -25,6 +25,9 @@ void add_topology_commands(CLI::App& app, CommandContext& context);
 /// `drover topology-agent`: a topology agent process (agents/topology_agent/).
 void add_topology_agent_command(CLI::App& app, CommandContext& context);
 
+/// `drover logical-agent`: the logical agent of one vehicle (agents/logical_agent/).
+void add_logical_agent_command(CLI::App& app, CommandContext& context);
+
 /// `drover ran-sim ...`: a simulated vehicle as a RAN process (agents/ran_runner/cli/).
 void add_ran_commands(CLI::App& app, CommandContext& context);
 

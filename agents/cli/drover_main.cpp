@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   add_topology_commands(app, context);
   add_topology_agent_command(app, context);
   add_ran_commands(app, context);
+  add_logical_agent_command(app, context);
   add_launch_command(app, context);
   add_load_generator_command(app, context);
   drover::bench::add_bench_commands(app, context);

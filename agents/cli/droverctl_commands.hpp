@@ -12,4 +12,7 @@ namespace drover::cli {
 /// `droverctl agents`: the live agents, from their heartbeats.
 void add_agents_command(CLI::App& app, CommandContext& context);
 
+/// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent.
+void add_order_command(CLI::App& app, CommandContext& context);
+
 }  // namespace drover::cli

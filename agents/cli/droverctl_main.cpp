@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
 
   CommandContext context;
   add_agents_command(app, context);
+  add_order_command(app, context);
 
   try {
     app.parse(argc, argv);

@@ -9,6 +9,7 @@
 
 #include "diagnosticsPubSubTypes.h"
 #include "heartbeatPubSubTypes.h"
+#include "routingPubSubTypes.h"
 #include "topologyPubSubTypes.h"
 
 namespace drover::dds {
@@ -43,6 +44,8 @@ DROVER_DDS_MESSAGE(DelayRequest);
 DROVER_DDS_MESSAGE(DelayReply);
 DROVER_DDS_MESSAGE(CancelRouteRequest);
 DROVER_DDS_MESSAGE(ReservationNotice);
+DROVER_DDS_MESSAGE(RouteRequest);
+DROVER_DDS_MESSAGE(RouteReply);
 
 /// A TypeSupport that serialises T.
 template <class T>

@@ -1,0 +1,630 @@
+// The logical agent's executor thread: orders, routes, allocation ahead, moves, footprint
+// and time-window monitoring, delays, locks, RAN errors, parking and charging.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include <boost/geometry.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "agents/logical_agent/src/logical_agent.hpp"
+#include "drover/dds/wire_error.hpp"
+
+namespace drover::logical_agent {
+
+namespace bg = boost::geometry;
+
+namespace {
+
+/// Pause (real time) between two route attempts the timelines or a missing agent refused.
+constexpr std::chrono::milliseconds kRoutePause{500};
+/// A RAN silent for this long (real time) counts as a recoverable error ("ran_lost").
+constexpr std::chrono::seconds kRanSilence{3};
+/// After a failed attempt to reach a charger, the next one waits this long (shared clock).
+constexpr DurationNs kChargeRetry = seconds_to_ns(30);
+
+bool nobody_answered(const Error& error) {
+  return error.code == ErrorCode::timeout || error.code == ErrorCode::unavailable;
+}
+
+std::string seconds_text(DurationNs ns) { return fmt::format("{:.1f} s", ns_to_seconds(ns)); }
+
+}  // namespace
+
+bool LogicalAgent::wait_event() {
+  std::unique_lock lock(mutex_);
+  wake_.wait_for(lock, options_.tick, [&] { return stopping_ || events_ != seen_events_; });
+  seen_events_ = events_;
+  return !stopping_;
+}
+
+std::optional<ran::VehicleStatus> LogicalAgent::latest_status() {
+  std::lock_guard lock(mutex_);
+  return status_;
+}
+
+void LogicalAgent::run() {
+  idle_since_ = clock_.now();
+  while (!stopping_) {
+    bool replan = false;
+    process_notices(replan);
+    if (!route_) {
+      if (!hold_position()) {
+        publish_vehicle_state(false);
+        wait_event();
+        continue;
+      }
+      set_activity(Activity::idle);
+    }
+    const auto status = latest_status();
+    const bool battery_low = status && options_.charge_below > 0 &&
+                             status->battery.state_of_charge < options_.charge_below && !status->battery.charging;
+    bool has_work = false;
+    {
+      std::lock_guard lock(mutex_);
+      has_work = book_.current() != nullptr || book_.queued_count() > 0;
+    }
+    if (battery_low && clock_.now() >= charge_retry_at_) {
+      go_to_service_vertex(topology::VertexKind::charger);
+      continue;
+    }
+    if (has_work) {
+      {
+        std::lock_guard lock(mutex_);
+        book_.start_next(clock_.now());
+      }
+      execute_order();
+      set_activity(Activity::idle);
+      continue;
+    }
+    if (options_.park_after >= 0 && activity_ == Activity::idle && vertex_ &&
+        topology_->vertex(*vertex_).kind != topology::VertexKind::parking &&
+        clock_.now() - idle_since_ >= options_.park_after) {
+      go_to_service_vertex(topology::VertexKind::parking);
+      set_activity(Activity::idle);
+      continue;
+    }
+    publish_vehicle_state(false);
+    wait_event();
+  }
+  // Clean shutdown: future reservations go; what the vehicle occupies stays allocated.
+  if (route_) {
+    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id()); !cancelled) {
+      spdlog::warn("route {} not cancelled on shutdown: {}", route_->id(), cancelled.error().message);
+    } else {
+      spdlog::info("route {} cancelled on shutdown", route_->id());
+    }
+  }
+}
+
+std::optional<topology::EntityIndex> LogicalAgent::vertex_under(const ran::VehicleStatus& status) const {
+  const topology::Point position(status.pose.x, status.pose.y);
+  std::optional<topology::EntityIndex> best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (topology::EntityIndex v = 0; v < topology_->vertex_count(); ++v) {
+    if (!bg::covered_by(position, topology_->footprint(v))) continue;
+    const double distance = bg::distance(position, topology_->vertex(v).position);
+    if (distance < best_distance) {
+      best = v;
+      best_distance = distance;
+    }
+  }
+  return best;
+}
+
+bool LogicalAgent::hold_position() {
+  const auto status = latest_status();
+  if (!status) return false;
+  const auto vertex = vertex_under(*status);
+  if (!vertex) {
+    set_activity(Activity::error);
+    if (!position_alarm_raised_) {
+      raise_alarm(msg::ALARM_ERROR, fmt::format("vehicle '{}' at ({:.2f}, {:.2f}) stands on no vertex of '{}'",
+                                                vehicle_id(), status->pose.x, status->pose.y, topology_->name()));
+      position_alarm_raised_ = true;
+    }
+    return false;
+  }
+  vertex_ = vertex;
+  auto route = plan_route(*vertex, 0);
+  if (!route) {
+    spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), route.error().message);
+    return false;
+  }
+  if (auto switched = switch_route(std::move(*route)); !switched) {
+    spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), switched.error().message);
+    return false;
+  }
+  position_alarm_raised_ = false;
+  spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
+  return true;
+}
+
+Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, DurationNs patience) {
+  const TimeNs give_up = clock_.now() + patience;
+  bool warned = false;
+  for (;;) {
+    if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
+    topology::RouteId id = 0;
+    while (id == 0) id = route_ids_();
+    msg::RouteRequest request;
+    request.agent(vehicle_id());
+    request.route(id);
+    request.real(true);
+    auto& vehicle = request.vehicle();
+    vehicle.id(options_.vehicle.id);
+    vehicle.type(options_.vehicle.type);
+    vehicle.max_speed(options_.vehicle.max_speed);
+    vehicle.acceleration(options_.vehicle.acceleration);
+    vehicle.deceleration(options_.vehicle.deceleration);
+    vehicle.length(options_.vehicle.length);
+    vehicle.width(options_.vehicle.width);
+    vehicle.payload(options_.vehicle.payload);
+    request.start(topology_->id(*vertex_));
+    request.start_time(clock_.now());
+    msg::RouteStop stop;
+    stop.vertex(topology_->id(goal));
+    stop.has_dwell(false);
+    request.stops().push_back(stop);
+
+    auto reply = services_->route(request, options_.route_timeout);
+    if (!reply) {
+      // Nobody answered (a routing agent restarting): the route may have been reserved
+      // with the reply lost, so cancel it before asking again under a new id.
+      if (!warned) {
+        spdlog::warn("route to '{}': {} (retrying until a routing agent answers)", topology_->id(goal),
+                     reply.error().message);
+        warned = true;
+      }
+      cancel_route_quietly(id);
+      set_activity(Activity::waiting);
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
+      continue;
+    }
+    if (auto status = dds::from_wire(reply->error()); status) {
+      std::vector<topology::RouteStep> steps;
+      for (const auto& step : reply->steps()) {
+        const auto entity = topology_->find(step.entity());
+        if (!entity) {
+          cancel_route_quietly(reply->route());
+          return fail(ErrorCode::not_found, "the route names '" + step.entity() + "', which topology '" +
+                                                topology_->name() + "' does not have");
+        }
+        steps.push_back(topology::RouteStep{*entity, {step.window().start(), step.window().end()}});
+      }
+      if (steps.empty() || steps.front().entity != *vertex_ || steps.back().entity != goal) {
+        cancel_route_quietly(reply->route());
+        return fail(ErrorCode::internal, "the routing agent answered a route that does not lead from '" +
+                                             topology_->id(*vertex_) + "' to '" + topology_->id(goal) + "'");
+      }
+      spdlog::info("route {} to '{}': {} steps, {:.1f} m, arrival in {}", reply->route(), topology_->id(goal),
+                   steps.size(), reply->distance(), seconds_text(reply->arrival() - clock_.now()));
+      return RouteTracker(topology_, reply->route(), std::move(steps));
+    } else {
+      const std::string& failure = reply->failure();
+      const bool blocked = failure == "no_window" || failure == "locked" || failure == "conflict" ||
+                           nobody_answered(status.error());
+      if (!blocked || clock_.now() >= give_up) {
+        return fail(status.error().code, "no route from '" + topology_->id(*vertex_) + "' to '" +
+                                             topology_->id(goal) + "': " + status.error().message);
+      }
+      if (!warned) {
+        spdlog::info("no route to '{}' yet ({}): retrying", topology_->id(goal), status.error().message);
+        warned = true;
+      }
+      set_activity(Activity::waiting);
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
+    }
+  }
+}
+
+Status LogicalAgent::switch_route(RouteTracker next) {
+  const auto here = next.step(0).entity;
+  // The vehicle holds `here` under the previous route: hand the allocation over to the new
+  // route's first step (nobody can come between: the new reservation starts now and the
+  // old one held the vertex since the vehicle arrived).
+  if (monitor_.holds(here)) {
+    if (auto released = services_->release(vehicle_id(), here); !released) return released;
+    monitor_.drop(here);
+  }
+  for (;;) {
+    if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
+    auto outcome = services_->allocate(vehicle_id(), here, options_.allocate_wait);
+    if (!outcome) return unexpected(outcome.error());
+    if (outcome->granted) break;
+  }
+  if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
+  monitor_.forget_steps();
+  monitor_.hold(here, 0);
+  next.mark_allocated();
+  route_ = std::move(next);
+  pending_moves_.clear();
+  own_shift_echoes_.clear();
+  return {};
+}
+
+Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience) {
+  drive_activity_ = activity;
+  for (;;) {
+    if (route_ && route_->arrived() && vertex_ == goal) return {};
+    set_activity(activity);
+    auto route = plan_route(goal, patience);
+    if (!route) {
+      // Stranded half-way (a re-plan found nothing): the rest of the old route must not
+      // keep blocking others.
+      if (route_ && !route_->arrived()) abandon_route();
+      return unexpected(route.error());
+    }
+    if (auto switched = switch_route(std::move(*route)); !switched) return switched;
+    std::string failure;
+    switch (follow(failure)) {
+      case FollowResult::arrived:
+        vertex_ = goal;
+        return {};
+      case FollowResult::replan:
+        spdlog::info("re-planning from '{}'", topology_->id(*vertex_));
+        continue;
+      case FollowResult::failed:
+        abandon_route();
+        return fail(ErrorCode::unavailable, failure);
+    }
+  }
+}
+
+LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
+  bool replan = false;
+  for (;;) {
+    if (stopping_) {
+      failure = "the logical agent is shutting down";
+      return FollowResult::failed;
+    }
+    process_notices(replan);
+    // Moves the RAN ended, in order.
+    {
+      std::unique_lock lock(mutex_);
+      while (!pending_moves_.empty()) {
+        const auto [id, target] = pending_moves_.front();
+        const auto ended = ended_commands_.find(id);
+        if (ended == ended_commands_.end()) break;
+        if (ended->second.state != ran::CommandState::finished) {
+          failure = fmt::format("move to '{}' {}: {} {}", topology_->id(route_->step(target).entity),
+                                ran::to_string(ended->second.state), ended->second.code, ended->second.reason);
+          lock.unlock();
+          raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+          stop_vehicle();
+          return FollowResult::failed;
+        }
+        route_->mark_reached(target);
+        vertex_ = route_->step(target).entity;
+        ended_commands_.erase(ended);
+        pending_moves_.pop_front();
+      }
+    }
+    const auto status = latest_status();
+    if (status) {
+      if (!monitor_.inside(status->footprint)) {
+        stop_vehicle();
+        failure = fmt::format("the footprint of vehicle '{}' left its allocated area near ({:.2f}, {:.2f}) by {:.3f} m^2",
+                              vehicle_id(), status->pose.x, status->pose.y, monitor_.area_outside(status->footprint));
+        raise_alarm(msg::ALARM_CRITICAL, failure);
+        return FollowResult::failed;
+      }
+      if (auto error = check_errors(*status)) {
+        stop_vehicle();
+        failure = *error;
+        return FollowResult::failed;
+      }
+      release_passed(*status);
+      const topology::Point position(status->pose.x, status->pose.y);
+      if (auto late = route_->lateness(position, status->linear_speed, options_.vehicle, clock_.now());
+          late && *late > options_.delay_threshold) {
+        propagate_delay(route_->position_step(), *late + options_.delay_threshold);
+      }
+    }
+    if (route_->arrived() && pending_moves_.empty()) return FollowResult::arrived;
+    if (replan) {
+      if (pending_moves_.empty()) return FollowResult::replan;
+    } else {
+      // Allocation ahead, in route order, within the look-ahead.
+      while (auto next = route_->next_to_allocate(route_->position_step(), options_.lookahead)) {
+        const auto entity = route_->step(*next).entity;
+        auto outcome = services_->allocate(vehicle_id(), entity, options_.allocate_wait);
+        if (!outcome) {
+          // Our reservation there is gone (cancelled, or the topology agent lost it): the
+          // rest of the route is no longer ours.
+          spdlog::warn("allocation of '{}' refused: {}", topology_->id(entity), outcome.error().message);
+          replan = true;
+          break;
+        }
+        if (!outcome->granted) break;
+        monitor_.hold(entity, *next);
+        route_->mark_allocated();
+      }
+      // Moves up to the last allocated vertex.
+      while (auto edge = route_->next_move()) {
+        const auto move = route_->command_move(*edge, next_command_id(), options_.vehicle.max_speed);
+        auto verdict = ran_->move(move, options_.call_timeout);
+        if (!verdict || verdict->rejected()) {
+          failure = verdict ? fmt::format("the RAN rejected the move to '{}': {} {}", move.target_vertex,
+                                          verdict->code, verdict->reason)
+                            : "the RAN did not take the move to '" + move.target_vertex + "': " + verdict.error().message;
+          raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+          stop_vehicle();
+          return FollowResult::failed;
+        }
+        pending_moves_.emplace_back(move.id, *edge + 1);
+      }
+    }
+    set_activity(error_since_ || pending_moves_.empty() ? Activity::waiting : drive_activity_);
+    publish_vehicle_state(false);
+    wait_event();
+  }
+}
+
+void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
+  for (const auto entity : monitor_.releasable(status.footprint, route_ ? route_->reached() : 0)) {
+    if (auto released = services_->release(vehicle_id(), entity); !released) {
+      spdlog::warn("release of '{}' failed: {}", topology_->id(entity), released.error().message);
+      continue;
+    }
+    monitor_.drop(entity);
+  }
+}
+
+std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& status) {
+  const ran::VehicleError* fatal = nullptr;
+  const ran::VehicleError* recoverable = nullptr;
+  for (const auto& error : status.errors) {
+    if (error.level == ran::ErrorLevel::fatal && fatal == nullptr) fatal = &error;
+    if (error.level == ran::ErrorLevel::recoverable && recoverable == nullptr) recoverable = &error;
+  }
+  if (fatal != nullptr) {
+    const std::string reason = "unrecoverable RAN error " + fatal->code + ": " + fatal->text;
+    raise_alarm(msg::ALARM_CRITICAL, "vehicle '" + vehicle_id() + "': " + reason);
+    return reason;
+  }
+  std::string cause;
+  if (recoverable != nullptr) {
+    cause = recoverable->code + ": " + recoverable->text;
+  } else {
+    std::lock_guard lock(mutex_);
+    if (std::chrono::steady_clock::now() - status_received_ > kRanSilence) cause = "ran_lost: no status from the RAN";
+  }
+  if (cause.empty()) {
+    if (error_since_) spdlog::info("RAN error over after {}", seconds_text(clock_.now() - *error_since_));
+    error_since_.reset();
+    return std::nullopt;
+  }
+  const TimeNs now = clock_.now();
+  if (!error_since_) {
+    spdlog::warn("recoverable RAN error {}: waiting it out", cause);
+    error_since_ = now;
+  } else if (now - *error_since_ > options_.error_limit) {
+    const std::string reason = "recoverable RAN error " + cause + " lasted longer than " + seconds_text(options_.error_limit);
+    raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + reason);
+    error_since_.reset();
+    return reason;
+  }
+  return std::nullopt;
+}
+
+void LogicalAgent::propagate_delay(std::size_t from_step, DurationNs by) {
+  const auto entity = route_->step(from_step).entity;
+  auto shifts = services_->delay(vehicle_id(), route_->id(), entity, by);
+  if (!shifts) {
+    spdlog::warn("delay of {} at '{}' not propagated: {}", seconds_text(by), topology_->id(entity),
+                 shifts.error().message);
+    return;
+  }
+  for (const auto& shift : *shifts) {
+    if (shift.agent == vehicle_id() && shift.route == route_->id()) {
+      route_->shift(shift.from_step, shift.by);
+      own_shift_echoes_.insert({shift.route, shift.by});
+    }
+  }
+  spdlog::info("delay of {} propagated from '{}' (step {}): {} route(s) moved", seconds_text(by),
+               topology_->id(entity), from_step, shifts->size());
+  // The owners of the rest of the route's partitions move their part too.
+  std::set<std::string> partitions{topology_->partition(entity)};
+  for (std::size_t step = from_step + 1; step < route_->size(); ++step) {
+    const auto other = route_->step(step).entity;
+    if (!partitions.insert(topology_->partition(other)).second) continue;
+    auto more = services_->delay(vehicle_id(), route_->id(), other, by);
+    if (!more) continue;
+    for (const auto& shift : *more) {
+      if (shift.agent == vehicle_id() && shift.route == route_->id()) own_shift_echoes_.insert({shift.route, shift.by});
+    }
+  }
+}
+
+void LogicalAgent::process_notices(bool& replan) {
+  std::deque<msg::ReservationNotice> batch;
+  {
+    std::lock_guard lock(mutex_);
+    batch.swap(notices_);
+  }
+  for (const auto& notice : batch) {
+    if (!route_ || notice.route() != route_->id()) continue;
+    if (notice.kind() == msg::NOTICE_SHIFTED) {
+      const auto echo = own_shift_echoes_.find({notice.route(), notice.shift()});
+      if (echo != own_shift_echoes_.end()) {
+        own_shift_echoes_.erase(echo);
+        continue;
+      }
+      route_->shift(notice.from_step(), notice.shift());
+      spdlog::info("following a delay: route {} moved by {} from step {} ('{}' delayed at '{}')", notice.route(),
+                   seconds_text(notice.shift()), notice.from_step(), notice.source(), notice.entity());
+      // Parts of the route other topology agents own move too.
+      const auto source_partitions = services_->partitions_of(notice.source());
+      std::set<std::string> partitions(source_partitions.begin(), source_partitions.end());
+      for (std::size_t step = notice.from_step(); step < route_->size(); ++step) {
+        const auto entity = route_->step(step).entity;
+        if (!partitions.insert(topology_->partition(entity)).second) continue;
+        auto more = services_->delay(vehicle_id(), route_->id(), entity, notice.shift());
+        if (!more) continue;
+        for (const auto& shift : *more) {
+          if (shift.agent == vehicle_id() && shift.route == route_->id()) {
+            own_shift_echoes_.insert({shift.route, shift.by});
+          }
+        }
+      }
+    } else if (notice.kind() == msg::NOTICE_LOCK_HIT) {
+      const auto locked = topology_->find(notice.entity());
+      if (!locked) continue;
+      for (std::size_t step = route_->allocated(); step < route_->size(); ++step) {
+        const auto entity = route_->step(step).entity;
+        const auto conflicts = topology_->conflicts(entity);
+        if (entity == *locked || std::find(conflicts.begin(), conflicts.end(), *locked) != conflicts.end()) {
+          spdlog::info("lock {} on '{}' hits route {} at step {}: re-planning", notice.lock_id(), notice.entity(),
+                       route_->id(), step);
+          replan = true;
+          break;
+        }
+      }
+    }
+  }
+}
+
+void LogicalAgent::stop_vehicle() {
+  if (pending_moves_.empty()) return;
+  if (auto cancelled = ran_->cancel(pending_moves_.front().first, options_.call_timeout); !cancelled) {
+    spdlog::warn("cancel of the moves not delivered: {}", cancelled.error().message);
+  }
+  pending_moves_.clear();
+}
+
+void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
+  if (auto cancelled = services_->cancel_route(vehicle_id(), route); !cancelled) {
+    spdlog::warn("route {} not cancelled: {}", route, cancelled.error().message);
+  }
+}
+
+void LogicalAgent::abandon_route() {
+  if (!route_) return;
+  cancel_route_quietly(route_->id());
+  pending_moves_.clear();
+  monitor_.forget_steps();
+  if (const auto status = latest_status()) {
+    for (const auto entity : monitor_.releasable(status->footprint, 0)) {
+      if (services_->release(vehicle_id(), entity)) monitor_.drop(entity);
+    }
+  }
+  route_.reset();
+}
+
+Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activity) {
+  set_activity(activity);
+  ran::ActionCommand action = requested;
+  action.id = next_command_id();
+  auto verdict = ran_->action(action, options_.call_timeout);
+  if (!verdict) return fail(verdict.error().code, "the RAN did not take action '" + action.name + "': " + verdict.error().message);
+  if (verdict->rejected()) {
+    return fail(ErrorCode::not_permitted, "the RAN rejected action '" + action.name + "': " + verdict->code + " " + verdict->reason);
+  }
+  for (;;) {
+    if (!wait_event()) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
+    bool replan = false;
+    process_notices(replan);
+    std::optional<ran::CommandProgress> ended;
+    {
+      std::lock_guard lock(mutex_);
+      if (auto found = ended_commands_.find(action.id); found != ended_commands_.end()) {
+        ended = found->second;
+        ended_commands_.erase(found);
+      }
+    }
+    if (ended) {
+      if (ended->state == ran::CommandState::finished) return {};
+      return fail(ErrorCode::unavailable, "action '" + action.name + "' " + ran::to_string(ended->state) + ": " +
+                                              ended->code + " " + ended->reason);
+    }
+    if (const auto status = latest_status()) {
+      if (auto error = check_errors(*status)) {
+        if (auto cancelled = ran_->cancel(action.id, options_.call_timeout); !cancelled) {
+          spdlog::warn("cancel of action '{}' not delivered: {}", action.name, cancelled.error().message);
+        }
+        return fail(ErrorCode::unavailable, *error);
+      }
+    }
+    publish_vehicle_state(false);
+  }
+}
+
+void LogicalAgent::execute_order() {
+  for (;;) {
+    Destination destination;
+    std::string name;
+    {
+      std::lock_guard lock(mutex_);
+      const Order* order = book_.current();
+      if (order == nullptr) return;
+      destination = order->destinations[order->destination];
+      name = order->name;
+    }
+    Status done = drive_to(destination.location, Activity::driving, options_.route_limit);
+    if (done) {
+      if (auto action = operation_action(destination)) {
+        const bool charge = action->kind == ran::ActionKind::charge;
+        if (charge && !action->parameters.count("target")) action->parameters["target"] = std::to_string(options_.charge_to);
+        done = operate(*action, charge ? Activity::charging : Activity::operating);
+      }
+    }
+    if (!done) {
+      if (!stopping_) {
+        raise_alarm(msg::ALARM_ERROR, "order '" + name + "' of vehicle '" + vehicle_id() + "' failed: " + done.error().message);
+      }
+      std::lock_guard lock(mutex_);
+      book_.fail_current(done.error().message, clock_.now());
+      return;
+    }
+    std::lock_guard lock(mutex_);
+    if (!book_.advance(clock_.now())) return;
+  }
+}
+
+void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
+  const bool charger = kind == topology::VertexKind::charger;
+  const auto here = topology_->vertex(*vertex_).position;
+  std::vector<topology::EntityIndex> candidates;
+  for (topology::EntityIndex v = 0; v < topology_->vertex_count(); ++v) {
+    if (topology_->vertex(v).kind == kind) candidates.push_back(v);
+  }
+  std::sort(candidates.begin(), candidates.end(), [&](auto a, auto b) {
+    return bg::distance(here, topology_->vertex(a).position) < bg::distance(here, topology_->vertex(b).position);
+  });
+  const Activity activity = charger ? Activity::charging : Activity::parking;
+  bool reached = topology_->vertex(*vertex_).kind == kind;
+  for (const auto candidate : candidates) {
+    if (reached || stopping_) break;
+    spdlog::info("{}: trying '{}'", charger ? "going to charge" : "parking", topology_->id(candidate));
+    if (auto driven = drive_to(candidate, activity, 0); driven) {
+      reached = true;
+    } else {
+      spdlog::info("'{}' not reached: {}", topology_->id(candidate), driven.error().message);
+      if (!route_) return;  // the route failed on the way (an alarm was raised)
+    }
+  }
+  idle_since_ = clock_.now();
+  if (!reached) {
+    if (charger) charge_retry_at_ = clock_.now() + kChargeRetry;
+    spdlog::warn("no {} vertex could be reached", charger ? "charger" : "parking");
+    return;
+  }
+  if (charger) {
+    ran::ActionCommand charge;
+    charge.kind = ran::ActionKind::charge;
+    charge.name = "charge";
+    charge.parameters["target"] = std::to_string(options_.charge_to);
+    if (auto charged = operate(charge, Activity::charging); !charged) {
+      charge_retry_at_ = clock_.now() + kChargeRetry;
+      raise_alarm(msg::ALARM_WARNING, "vehicle '" + vehicle_id() + "' could not charge: " + charged.error().message);
+    }
+  }
+}
+
+}  // namespace drover::logical_agent

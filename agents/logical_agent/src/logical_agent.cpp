@@ -1,0 +1,262 @@
+// Setup of the logical agent's DDS entities, its callbacks and what it publishes. The
+// executor (driving) is in executor.cpp.
+
+#include "agents/logical_agent/src/logical_agent.hpp"
+
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+#include "drover/dds/wire_error.hpp"
+#include "drover/logical_agent/names.hpp"
+#include "drover/ran_runner/names.hpp"
+
+namespace drover::logical_agent {
+
+namespace {
+
+/// The topology agents' notices (docs/topology-agent.md "Topics").
+constexpr const char* kTopologyNoticeTopic = "drover/topology/notices";
+
+msg::OptionalTime optional_time(const std::optional<TimeNs>& time) {
+  msg::OptionalTime out;
+  out.present(time.has_value());
+  out.ns(time.value_or(0));
+  return out;
+}
+
+msg::OrderState to_wire(OrderState state) {
+  switch (state) {
+    case OrderState::queued: return msg::ORDER_QUEUED;
+    case OrderState::running: return msg::ORDER_RUNNING;
+    case OrderState::finished: return msg::ORDER_FINISHED;
+    case OrderState::failed: return msg::ORDER_FAILED;
+  }
+  return msg::ORDER_FAILED;
+}
+
+}  // namespace
+
+LogicalAgent::LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock,
+                           LogicalAgentOptions options)
+    : topology_(std::move(topology)),
+      clock_(clock),
+      options_(std::move(options)),
+      book_([this](const Order& order) { publish_progress(order); }),
+      monitor_(topology_),
+      command_prefix_(std::to_string(SharedClock::unix_now())),
+      route_ids_(static_cast<std::uint64_t>(SharedClock::unix_now())) {}
+
+Result<std::unique_ptr<LogicalAgent>> LogicalAgent::create(std::shared_ptr<const topology::Topology> topology,
+                                                           SharedClock clock, LogicalAgentOptions options) {
+  if (auto valid = carp::validate(options.vehicle); !valid) {
+    return fail(ErrorCode::invalid_argument, "vehicle profile: " + valid.error().message);
+  }
+  if (options.lookahead == 0) return fail(ErrorCode::invalid_argument, "lookahead must be at least 1 vertex");
+  if (options.vehicle.id.empty()) options.vehicle.id = options.participant.agent_id;
+  std::unique_ptr<LogicalAgent> agent(new LogicalAgent(std::move(topology), clock, std::move(options)));
+  if (auto started = agent->start(); !started) return unexpected(started.error());
+  return agent;
+}
+
+Status LogicalAgent::start() {
+  auto participant = dds::Participant::create(options_.participant);
+  if (!participant) return unexpected(participant.error());
+  participant_ = std::move(*participant);
+  auto services = TopologyServices::create(*participant_, topology_, options_.call_timeout, stopping_);
+  if (!services) return unexpected(services.error());
+  services_ = std::move(*services);
+
+  auto progress = dds::Writer<msg::OrderProgress>::create(*participant_, kOrderProgressTopic);
+  if (!progress) return unexpected(progress.error());
+  progress_writer_ = std::move(*progress);
+  auto vehicle = dds::Writer<msg::VehicleState>::create(*participant_, kVehicleStateTopic);
+  if (!vehicle) return unexpected(vehicle.error());
+  vehicle_writer_ = std::move(*vehicle);
+  auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, dds::TopicQos::events());
+  if (!alarms) return unexpected(alarms.error());
+  alarm_writer_ = std::move(*alarms);
+
+  dds::HeartbeatOptions beat;
+  beat.kind = "logical";
+  beat.owns = {vehicle_id()};
+  auto heartbeat = dds::HeartbeatPublisher::create(*participant_, clock_, beat);
+  if (!heartbeat) return unexpected(heartbeat.error());
+  heartbeat_ = std::move(*heartbeat);
+
+  auto ran = ran::RanClient::create(*participant_, vehicle_id(), options_.ran_agent, 16,
+                                    [this](const ran::VehicleStatus& status) { on_status(status); });
+  if (!ran) return unexpected(ran.error());
+  ran_ = std::move(*ran);
+
+  dds::ReaderOptions notice_options;
+  notice_options.qos = dds::TopicQos::events();
+  notice_options.filter_expression = "agent = %0";
+  notice_options.filter_parameters = {"'" + vehicle_id() + "'"};
+  auto notices = dds::Reader<msg::ReservationNotice>::create(
+      *participant_, kTopologyNoticeTopic, [this](const msg::ReservationNotice& notice) { on_notice(notice); },
+      notice_options);
+  if (!notices) return unexpected(notices.error());
+  notice_reader_ = std::move(*notices);
+
+  auto server = dds::ServiceServer<msg::OrderRequest, msg::OrderReply>::create(
+      *participant_, kServiceArea, kOrderService,
+      [this](const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply) {
+        on_order(request, std::move(reply));
+      });
+  if (!server) return unexpected(server.error());
+  order_server_ = std::move(*server);
+
+  executor_ = std::thread([this] { run(); });
+  return {};
+}
+
+LogicalAgent::~LogicalAgent() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (executor_.joinable()) executor_.join();
+  order_server_.reset();
+  notice_reader_.reset();
+  ran_.reset();
+  heartbeat_.reset();
+  alarm_writer_.reset();
+  vehicle_writer_.reset();
+  progress_writer_.reset();
+  services_.reset();
+  participant_.reset();
+}
+
+void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply) {
+  msg::OrderReply answer;
+  OrderSpec spec;
+  spec.name = request.order();
+  for (const auto& destination : request.destinations()) {
+    OrderSpec::Stop stop{destination.location(), destination.operation(), {}};
+    for (const auto& property : destination.properties()) stop.properties[property.name()] = property.value();
+    spec.destinations.push_back(std::move(stop));
+  }
+  for (const auto& property : request.properties()) spec.properties[property.name()] = property.value();
+  auto order = make_order(*topology_, spec);
+  if (!order) {
+    spdlog::warn("order refused: {}", order.error().message);
+    if (auto sent = reply.send_error(order.error()); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+    return;
+  }
+  Result<std::size_t> position = 0;
+  {
+    std::lock_guard lock(mutex_);
+    position = book_.add(std::move(*order), clock_.now());
+    ++events_;
+  }
+  wake_.notify_all();
+  if (!position) {
+    spdlog::warn("order refused: {}", position.error().message);
+    if (auto sent = reply.send_error(position.error()); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+    return;
+  }
+  spdlog::info("order '{}' queued at position {}", spec.name, *position);
+  answer.queue_position(static_cast<std::uint32_t>(*position));
+  if (auto sent = reply.send(std::move(answer)); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+}
+
+void LogicalAgent::on_notice(const msg::ReservationNotice& notice) {
+  {
+    std::lock_guard lock(mutex_);
+    notices_.push_back(notice);
+    ++events_;
+  }
+  wake_.notify_all();
+}
+
+void LogicalAgent::on_status(const ran::VehicleStatus& status) {
+  {
+    std::lock_guard lock(mutex_);
+    status_ = status;
+    status_received_ = std::chrono::steady_clock::now();
+    for (const auto& command : status.commands) {
+      if (ran::is_terminal(command.state) && command.id.rfind(command_prefix_, 0) == 0) {
+        ended_commands_.emplace(command.id, command);
+      }
+    }
+    ++events_;
+  }
+  wake_.notify_all();
+}
+
+void LogicalAgent::publish_progress(const Order& order) {
+  msg::OrderProgress progress;
+  progress.order(order.name);
+  progress.vehicle(vehicle_id());
+  progress.state(to_wire(order.state));
+  progress.destination(static_cast<std::uint32_t>(order.destination));
+  progress.destination_count(static_cast<std::uint32_t>(order.destinations.size()));
+  progress.created(optional_time(order.created));
+  progress.started(optional_time(order.started));
+  progress.finished(optional_time(order.finished));
+  progress.failure(order.failure);
+  spdlog::info("order '{}': {} (destination {}/{}){}", order.name, to_string(order.state), order.destination,
+               order.destinations.size(), order.failure.empty() ? "" : ": " + order.failure);
+  if (auto written = progress_writer_->write(progress); !written) {
+    spdlog::warn("order progress not published: {}", written.error().message);
+  }
+}
+
+void LogicalAgent::raise_alarm(msg::AlarmSeverity severity, const std::string& text) {
+  spdlog::error("alarm: {}", text);
+  msg::OperatorAlarm alarm;
+  alarm.agent(vehicle_id());
+  alarm.vehicle(vehicle_id());
+  alarm.severity(severity);
+  alarm.text(text);
+  alarm.time().ns(clock_.now());
+  if (auto written = alarm_writer_->write(alarm); !written) {
+    spdlog::warn("alarm not published: {}", written.error().message);
+  }
+}
+
+void LogicalAgent::set_activity(Activity activity) {
+  if (activity_ == activity) return;
+  if (activity == Activity::idle) idle_since_ = clock_.now();
+  activity_ = activity;
+  publish_vehicle_state(true);
+}
+
+void LogicalAgent::publish_vehicle_state(bool force) {
+  static constexpr msg::VehicleActivity kWire[] = {
+      msg::VEHICLE_IDLE,    msg::VEHICLE_DRIVING, msg::VEHICLE_OPERATING, msg::VEHICLE_PARKING,
+      msg::VEHICLE_CHARGING, msg::VEHICLE_WAITING, msg::VEHICLE_ERROR};
+  msg::VehicleState state;
+  state.vehicle(vehicle_id());
+  state.ran(options_.ran_agent.empty() ? ran::ran_agent_id(vehicle_id()) : options_.ran_agent);
+  state.state(kWire[static_cast<int>(activity_)]);
+  if (vertex_) state.vertex(topology_->id(*vertex_));
+  {
+    std::lock_guard lock(mutex_);
+    if (const Order* order = book_.current()) state.order(order->name);
+    state.queued_orders(static_cast<std::uint32_t>(book_.queued_count()));
+    if (status_) {
+      state.state_of_charge(status_->battery.state_of_charge);
+      state.moving(std::abs(status_->linear_speed) > 0.01 || std::abs(status_->angular_speed) > 0.01);
+    }
+  }
+  const auto real_now = std::chrono::steady_clock::now();
+  const bool changed = state.state() != last_published_.state() || state.vertex() != last_published_.vertex() ||
+                       state.order() != last_published_.order() || state.moving() != last_published_.moving() ||
+                       state.queued_orders() != last_published_.queued_orders();
+  if (!force && !changed && real_now - last_publication_ < std::chrono::seconds(1)) return;
+  state.time().ns(clock_.now());
+  last_published_ = state;
+  last_publication_ = real_now;
+  if (auto written = vehicle_writer_->write(state); !written) {
+    spdlog::warn("vehicle state not published: {}", written.error().message);
+  }
+}
+
+ran::CommandId LogicalAgent::next_command_id() {
+  return command_prefix_ + "-" + std::to_string(++command_counter_);
+}
+
+}  // namespace drover::logical_agent

@@ -1,0 +1,193 @@
+#pragma once
+// The logical agent of one vehicle (docs/logical-agent.md): serves the order service,
+// executes orders one at a time (per destination a real route from a routing agent,
+// allocation ahead of the vehicle in route order, move commands to the RAN up to the last
+// allocated vertex, the operation), watches the RAN's footprint and time windows, releases
+// what the vehicle has left, propagates and follows delays, re-plans around locks, handles
+// RAN errors, parks and charges when idle, and publishes order progress, vehicle state and
+// operator alarms.
+//
+// Threads: DDS callbacks only record what arrived (orders, notices, statuses) and wake the
+// executor; one executor thread does everything else, so the driving logic is sequential.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "agents/logical_agent/src/footprint_monitor.hpp"
+#include "agents/logical_agent/src/order_book.hpp"
+#include "agents/logical_agent/src/route_tracker.hpp"
+#include "agents/logical_agent/src/topology_services.hpp"
+#include "drover/carp/vehicle.hpp"
+#include "drover/common/clock.hpp"
+#include "drover/common/result.hpp"
+#include "drover/dds/heartbeat_publisher.hpp"
+#include "drover/dds/participant.hpp"
+#include "drover/dds/reader.hpp"
+#include "drover/dds/service_server.hpp"
+#include "drover/dds/writer.hpp"
+#include "drover/logical_agent/messages.hpp"
+#include "drover/ran_runner/client.hpp"
+
+namespace drover::logical_agent {
+
+struct LogicalAgentOptions {
+  /// DDS settings; participant.agent_id is the vehicle id.
+  dds::ParticipantOptions participant;
+  /// The RAN's agent id; empty: ran-<vehicle id>.
+  std::string ran_agent;
+  /// The vehicle, for routes and travel-time estimates (id and type included).
+  carp::VehicleProfile vehicle;
+  /// How many vertices ahead of the vehicle are allocated (>= 1).
+  std::size_t lookahead = 2;
+  /// A delay is propagated once the vehicle will reach its next vertex this much later
+  /// than planned; it is propagated as the estimated lateness plus this margin again.
+  DurationNs delay_threshold = seconds_to_ns(2);
+  /// Idle this long (shared clock) → drive to a free parking vertex; < 0: never.
+  DurationNs park_after = seconds_to_ns(30);
+  /// Below this state of charge the vehicle charges before new work; <= 0: never.
+  double charge_below = 0.2;
+  /// The state of charge a charge action aims at.
+  double charge_to = 0.9;
+  /// A recoverable RAN error (stall, protective field, lost RAN) lasting longer fails the
+  /// order with an alarm.
+  DurationNs error_limit = seconds_to_ns(60);
+  /// How long no route may be found (locks, full timelines) before the order fails.
+  DurationNs route_limit = seconds_to_ns(120);
+  /// Real-time period of the executor's checks when nothing arrives.
+  std::chrono::milliseconds tick{50};
+  /// Real-time timeouts: topology calls, route calls, one allocation wait.
+  std::chrono::milliseconds call_timeout{3000};
+  std::chrono::milliseconds route_timeout{10000};
+  std::chrono::milliseconds allocate_wait{300};
+};
+
+/// Serves from create() until destroyed.
+class LogicalAgent {
+ public:
+  /// \return the agent (its executor started), or invalid_argument (bad vehicle profile,
+  ///         lookahead 0), or the DDS layer's errors.
+  static Result<std::unique_ptr<LogicalAgent>> create(std::shared_ptr<const topology::Topology> topology,
+                                                      SharedClock clock, LogicalAgentOptions options);
+  /// Stops the executor (cancelling the current route's future reservations), then the
+  /// DDS entities.
+  ~LogicalAgent();
+  LogicalAgent(const LogicalAgent&) = delete;
+  LogicalAgent& operator=(const LogicalAgent&) = delete;
+
+  const std::string& vehicle_id() const noexcept { return participant_->agent_id(); }
+
+ private:
+  enum class Activity { idle, driving, operating, parking, charging, waiting, error };
+  /// How following a route ended.
+  enum class FollowResult { arrived, replan, failed };
+
+  LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options);
+  Status start();
+
+  // ---- DDS callbacks (record and wake) ----
+  void on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply);
+  void on_notice(const msg::ReservationNotice& notice);
+  void on_status(const ran::VehicleStatus& status);
+  void publish_progress(const Order& order);
+
+  // ---- executor ----
+  void run();
+  /// Waits for an event or the tick. \return false when stopping.
+  bool wait_event();
+  std::optional<ran::VehicleStatus> latest_status();
+  /// Finds the vertex the vehicle stands on and holds it with a route to itself.
+  /// \return whether it holds one now.
+  bool hold_position();
+  std::optional<topology::EntityIndex> vertex_under(const ran::VehicleStatus& status) const;
+  /// A real route from the vehicle's vertex to `goal`, retried (within route_limit) while
+  /// it is blocked. \return the route or why none.
+  /// \param patience  how long (shared clock) to keep trying while the timelines or locks
+  ///                  leave no route; 0: one try.
+  Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience);
+  /// Makes `next` the current route: swaps the vertex the vehicle holds onto it, cancels
+  /// the previous route.
+  Status switch_route(RouteTracker next);
+  /// Drives to `goal` (re-planning on locks). \return success, or why it failed.
+  Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience);
+  FollowResult follow(std::string& failure);
+  /// Performs an action where the vehicle stands. \return success or why it failed.
+  Status operate(const ran::ActionCommand& action, Activity activity);
+  void execute_order();
+  /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
+  void go_to_service_vertex(topology::VertexKind kind);
+  /// Gives up the current route after a failure: cancels its reservations, releases what
+  /// the footprint does not touch, holds the vertex the vehicle stands on again.
+  void abandon_route();
+  /// Cancels a route of ours on every topology agent; failures are logged.
+  void cancel_route_quietly(topology::RouteId route);
+  void release_passed(const ran::VehicleStatus& status);
+  void process_notices(bool& replan);
+  void propagate_delay(std::size_t from_step, DurationNs by);
+  void stop_vehicle();
+  /// Checks the RAN's errors. \return a failure reason once the order must fail.
+  std::optional<std::string> check_errors(const ran::VehicleStatus& status);
+  void raise_alarm(msg::AlarmSeverity severity, const std::string& text);
+  void set_activity(Activity activity);
+  void publish_vehicle_state(bool force);
+  ran::CommandId next_command_id();
+
+  const std::shared_ptr<const topology::Topology> topology_;
+  const SharedClock clock_;
+  const LogicalAgentOptions options_;
+  std::atomic<bool> stopping_{false};
+
+  // Shared with the callbacks, under mutex_.
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::uint64_t events_ = 0;
+  OrderBook book_;
+  std::deque<msg::ReservationNotice> notices_;
+  std::optional<ran::VehicleStatus> status_;
+  std::chrono::steady_clock::time_point status_received_{};
+  std::map<ran::CommandId, ran::CommandProgress> ended_commands_;  ///< ours, once terminal
+
+  // Executor state.
+  FootprintMonitor monitor_;
+  std::optional<RouteTracker> route_;
+  std::deque<std::pair<ran::CommandId, std::size_t>> pending_moves_;  ///< id, target step
+  std::optional<topology::EntityIndex> vertex_;  ///< where the vehicle stands or last stood
+  Activity activity_ = Activity::idle;
+  TimeNs idle_since_ = 0;
+  std::optional<TimeNs> error_since_;
+  std::multiset<std::pair<topology::RouteId, DurationNs>> own_shift_echoes_;
+  std::uint64_t command_counter_ = 0;
+  std::uint64_t seen_events_ = 0;
+  Activity drive_activity_ = Activity::driving;
+  TimeNs charge_retry_at_ = 0;
+  bool position_alarm_raised_ = false;
+  std::string command_prefix_;
+  std::mt19937_64 route_ids_;
+  msg::VehicleState last_published_;
+  std::chrono::steady_clock::time_point last_publication_{};
+
+  // DDS entities: the participant first (destroyed last), callbacks' sources last.
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<TopologyServices> services_;
+  std::unique_ptr<dds::Writer<msg::OrderProgress>> progress_writer_;
+  std::unique_ptr<dds::Writer<msg::VehicleState>> vehicle_writer_;
+  std::unique_ptr<dds::Writer<msg::OperatorAlarm>> alarm_writer_;
+  std::unique_ptr<dds::HeartbeatPublisher> heartbeat_;
+  std::unique_ptr<ran::RanClient> ran_;
+  std::unique_ptr<dds::Reader<msg::ReservationNotice>> notice_reader_;
+  std::unique_ptr<dds::ServiceServer<msg::OrderRequest, msg::OrderReply>> order_server_;
+  std::thread executor_;
+};
+
+}  // namespace drover::logical_agent

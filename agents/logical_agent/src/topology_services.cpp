@@ -1,0 +1,168 @@
+#include "agents/logical_agent/src/topology_services.hpp"
+
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "drover/dds/wire_error.hpp"
+
+namespace drover::logical_agent {
+
+namespace {
+
+constexpr const char* kTopologyArea = "topology";
+constexpr const char* kRoutingArea = "routing";
+/// Pause between retries of a call nobody answered.
+constexpr std::chrono::milliseconds kRetryPause{200};
+
+bool nobody_answered(const Error& error) {
+  return error.code == ErrorCode::timeout || error.code == ErrorCode::unavailable;
+}
+
+template <class Req, class Rep>
+Status make_client(std::unique_ptr<dds::ServiceClient<Req, Rep>>& client, dds::Participant& participant,
+                   const char* area, const char* service) {
+  auto created = dds::ServiceClient<Req, Rep>::create(participant, area, service);
+  if (!created) return unexpected(created.error());
+  client = std::move(*created);
+  return {};
+}
+
+}  // namespace
+
+Result<std::unique_ptr<TopologyServices>> TopologyServices::create(dds::Participant& participant,
+                                                                   std::shared_ptr<const topology::Topology> topology,
+                                                                   std::chrono::milliseconds call_timeout,
+                                                                   const std::atomic<bool>& stopping) {
+  std::unique_ptr<TopologyServices> services(new TopologyServices(std::move(topology), call_timeout, stopping));
+  auto directory = dds::AgentDirectory::create(participant);
+  if (!directory) return unexpected(directory.error());
+  services->directory_ = std::move(*directory);
+  for (auto status : {make_client(services->route_client_, participant, kRoutingArea, "route"),
+                      make_client(services->allocate_client_, participant, kTopologyArea, "allocate"),
+                      make_client(services->release_client_, participant, kTopologyArea, "release"),
+                      make_client(services->delay_client_, participant, kTopologyArea, "delay"),
+                      make_client(services->cancel_client_, participant, kTopologyArea, "cancel_route")}) {
+    if (!status) return unexpected(status.error());
+  }
+  return services;
+}
+
+template <class T>
+Result<T> TopologyServices::retry(const std::function<Result<T>()>& call) const {
+  for (;;) {
+    auto result = call();
+    if (result || !nobody_answered(result.error())) return result;
+    if (stopping_) return result;
+    spdlog::warn("{} (retrying)", result.error().message);
+    std::this_thread::sleep_for(kRetryPause);
+  }
+}
+
+Result<std::string> TopologyServices::owner_of(topology::EntityIndex entity) const {
+  const std::string& partition = topology_->partition(entity);
+  for (const auto& agent : directory_->live_agents()) {
+    if (agent.kind == "topology" && std::find(agent.owns.begin(), agent.owns.end(), partition) != agent.owns.end()) {
+      return agent.id;
+    }
+  }
+  return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "' (entity '" +
+                                          topology_->id(entity) + "')");
+}
+
+std::vector<std::string> TopologyServices::partitions_of(const std::string& agent_id) const {
+  auto record = directory_->find(agent_id);
+  return record ? record->owns : std::vector<std::string>{};
+}
+
+Result<msg::RouteReply> TopologyServices::route(msg::RouteRequest request, std::chrono::milliseconds timeout) {
+  return route_client_->call(std::move(request), timeout);
+}
+
+Result<AllocateOutcome> TopologyServices::allocate(const std::string& agent, topology::EntityIndex entity,
+                                                   std::chrono::milliseconds timeout) {
+  auto owner = owner_of(entity);
+  if (!owner) return AllocateOutcome{};  // nobody to ask now: not granted, ask again later
+  msg::AllocateRequest request;
+  request.agent(agent);
+  request.entity(topology_->id(entity));
+  request.wait(true);
+  auto reply = allocate_client_->call(request, timeout, *owner);
+  if (!reply) {
+    if (nobody_answered(reply.error())) return AllocateOutcome{};
+    return unexpected(reply.error());
+  }
+  if (auto status = dds::from_wire(reply->error()); !status) {
+    if (nobody_answered(status.error())) return AllocateOutcome{};
+    return unexpected(status.error());
+  }
+  return AllocateOutcome{reply->granted(), reply->queue_position()};
+}
+
+Status TopologyServices::release(const std::string& agent, topology::EntityIndex entity) {
+  auto done = retry<bool>([&]() -> Result<bool> {
+    auto owner = owner_of(entity);
+    if (!owner) return unexpected(owner.error());
+    msg::ReleaseRequest request;
+    request.agent(agent);
+    request.entity(topology_->id(entity));
+    auto reply = release_client_->call(request, call_timeout_, *owner);
+    if (!reply) return unexpected(reply.error());
+    if (auto status = dds::from_wire(reply->error()); !status) {
+      if (status.error().code == ErrorCode::not_permitted) return false;
+      return unexpected(status.error());
+    }
+    return true;
+  });
+  if (!done) return unexpected(done.error());
+  return {};
+}
+
+Result<std::vector<topology::Shift>> TopologyServices::delay(const std::string& agent, topology::RouteId route,
+                                                              topology::EntityIndex entity, DurationNs by) {
+  return retry<std::vector<topology::Shift>>([&]() -> Result<std::vector<topology::Shift>> {
+    auto owner = owner_of(entity);
+    if (!owner) return unexpected(owner.error());
+    msg::DelayRequest request;
+    request.agent(agent);
+    request.route(route);
+    request.entity(topology_->id(entity));
+    request.by(by);
+    auto reply = delay_client_->call(request, call_timeout_, *owner);
+    if (!reply) return unexpected(reply.error());
+    if (auto status = dds::from_wire(reply->error()); !status) return unexpected(status.error());
+    std::vector<topology::Shift> shifts;
+    for (const auto& shift : reply->shifts()) {
+      shifts.push_back(topology::Shift{shift.agent(), shift.route(), shift.from_step(), shift.by()});
+    }
+    return shifts;
+  });
+}
+
+Status TopologyServices::cancel_route(const std::string& agent, topology::RouteId route) {
+  for (const auto& partition : topology_->partitions()) {
+    auto done = retry<bool>([&]() -> Result<bool> {
+      std::optional<std::string> owner;
+      for (const auto& record : directory_->live_agents()) {
+        if (record.kind == "topology" &&
+            std::find(record.owns.begin(), record.owns.end(), partition) != record.owns.end()) {
+          owner = record.id;
+        }
+      }
+      if (!owner) return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "'");
+      msg::CancelRouteRequest request;
+      request.agent(agent);
+      request.route(route);
+      auto reply = cancel_client_->call(request, call_timeout_, *owner);
+      if (!reply) return unexpected(reply.error());
+      if (auto status = dds::from_wire(reply->error()); !status && status.error().code != ErrorCode::not_found) {
+        return unexpected(status.error());
+      }
+      return true;
+    });
+    if (!done) return unexpected(done.error());
+  }
+  return {};
+}
+
+}  // namespace drover::logical_agent

@@ -1,0 +1,436 @@
+// Logical agents as processes with a topology agent, a routing agent and simulated RANs on
+// the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
+// watches what a user could watch: RAN statuses, timelines, notices, order progress,
+// alarms. Domains 186..199. Every agent is stopped with SIGTERM and must exit 0.
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <boost/geometry.hpp>
+#include <gtest/gtest.h>
+
+#include "drover/dds/participant.hpp"
+#include "drover/dds/reader.hpp"
+#include "drover/dds/service_client.hpp"
+#include "drover/logical_agent/messages.hpp"
+#include "drover/logical_agent/names.hpp"
+#include "drover/ran_runner/client.hpp"
+#include "drover/topology/topology_file.hpp"
+#include "tests/agents/child_process.hpp"
+
+namespace drover::test {
+namespace {
+
+namespace bg = boost::geometry;
+using namespace std::chrono_literals;
+
+/// Generous bound for a whole run on a loaded 2-core machine.
+constexpr auto kRunTimeout = 240s;
+constexpr double kTimeFactor = 2.0;
+
+std::string source_dir() {
+  const char* dir = std::getenv("DROVER_SOURCE_DIR");
+  return dir ? dir : ".";
+}
+
+/// One process per agent; logs under the test's temporary directory.
+class Fleet {
+ public:
+  Fleet(std::uint32_t domain, std::string name) : domain_(domain) {
+    dir_ = std::filesystem::temp_directory_path() / ("drover-fleet-" + name + "-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    topology_file_ = source_dir() + "/launch/topologies/h_crossing.json";
+    vehicle_file_ = (dir_ / "vehicle.json").string();
+    std::ofstream(vehicle_file_) << R"({"max_speed": 1.0, "acceleration": 0.5, "deceleration": 0.5,
+                                       "length": 0.6, "width": 0.4})";
+    origin_ = SharedClock::unix_now();
+  }
+  ~Fleet() { stop(); }
+
+  SharedClock clock() const { return *SharedClock::create_at_origin(origin_, kTimeFactor, origin_); }
+  const std::string& topology_file() const { return topology_file_; }
+
+  void start(const std::string& name, std::vector<std::string> args) {
+    args.insert(args.end(), {"--domain", std::to_string(domain_), "--time-factor", std::to_string(kTimeFactor),
+                             "--epoch", std::to_string(origin_), "--clock-origin", std::to_string(origin_)});
+    const auto log = (dir_ / (name + ".log")).string();
+    auto child = ChildProcess::spawn(binary_path("drover"), args, log, log);
+    ASSERT_TRUE(child.has_value()) << name;
+    children_.emplace_back(name, std::move(*child));
+  }
+  void start_infrastructure() {
+    start("topology", {"topology-agent", "--topology", topology_file_});
+    start("routing", {"routing-agent"});
+  }
+  void start_vehicle(const std::string& id, const std::string& at) {
+    start("ran-" + id, {"ran-sim", "--id", id, "--topology", topology_file_, "--at", at, "--max-speed", "1",
+                        "--acceleration", "0.5", "--deceleration", "0.5"});
+    start(id, {"logical-agent", "--id", id, "--topology", topology_file_, "--vehicle", vehicle_file_,
+               "--park-after", "-1", "--charge-below", "0"});
+  }
+  /// SIGTERM to everyone, newest first; each must exit 0.
+  void stop() {
+    while (!children_.empty()) {
+      auto& [name, child] = children_.back();
+      child.signal(SIGTERM);
+      const auto status = child.wait_exit(30s);
+      EXPECT_TRUE(status.has_value()) << name << " did not stop on SIGTERM";
+      if (status) EXPECT_TRUE(status->exited && status->code == 0) << name << " ended with " << status->code;
+      if (::testing::Test::HasFailure()) std::cerr << "---- " << name << " ----\n" << read_file((dir_ / (name + ".log")).string());
+      children_.pop_back();
+    }
+  }
+
+ private:
+  std::uint32_t domain_;
+  std::filesystem::path dir_;
+  std::string topology_file_;
+  std::string vehicle_file_;
+  TimeNs origin_ = 0;
+  std::vector<std::pair<std::string, ChildProcess>> children_;
+};
+
+/// Everything the test observes, in arrival order, with the shared-clock time of arrival.
+struct Observations {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::map<std::string, msg::OrderProgress> orders;
+  std::vector<msg::ReservationNotice> notices;
+  std::vector<msg::OperatorAlarm> alarms;
+  std::map<std::string, std::string> holders;                       ///< entity -> agent, now
+  std::vector<std::string> hold_violations;                         ///< conflicting holders seen
+  std::map<std::string, ran::VehicleStatus> latest;                 ///< vehicle -> status
+  std::vector<std::string> overlaps;                                ///< footprints overlapping
+  std::map<std::string, std::vector<std::pair<TimeNs, TimeNs>>> on_bar;  ///< vehicle -> times on bar-2
+  std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, holder)
+
+  bool wait(const std::function<bool()>& condition, std::chrono::seconds timeout) {
+    std::unique_lock lock(mutex);
+    return changed.wait_for(lock, timeout, condition);
+  }
+};
+
+class FleetTest : public ::testing::Test {
+ protected:
+  void watch(std::uint32_t domain, const Fleet& fleet, const std::vector<std::string>& vehicles) {
+    auto loaded = topology::load_topology_file(fleet.topology_file());
+    ASSERT_TRUE(loaded.has_value());
+    world_ = std::make_shared<topology::Topology>(std::move(*loaded));
+    clock_ = fleet.clock();
+    dds::ParticipantOptions options;
+    options.domain_id = domain;
+    options.agent_id = "tester";
+    auto participant = dds::Participant::create(options);
+    ASSERT_TRUE(participant.has_value()) << participant.error().message;
+    participant_ = std::move(*participant);
+
+    auto progress = dds::Reader<msg::OrderProgress>::create(*participant_, logical_agent::kOrderProgressTopic,
+                                                            [this](const msg::OrderProgress& sample) {
+                                                              std::lock_guard lock(seen_.mutex);
+                                                              seen_.orders[sample.order()] = sample;
+                                                              seen_.changed.notify_all();
+                                                            });
+    ASSERT_TRUE(progress.has_value());
+    progress_ = std::move(*progress);
+    dds::ReaderOptions events;
+    events.qos = dds::TopicQos::events();
+    auto notices = dds::Reader<msg::ReservationNotice>::create(
+        *participant_, "drover/topology/notices",
+        [this](const msg::ReservationNotice& notice) {
+          std::lock_guard lock(seen_.mutex);
+          seen_.notices.push_back(notice);
+          seen_.changed.notify_all();
+        },
+        events);
+    ASSERT_TRUE(notices.has_value());
+    notices_ = std::move(*notices);
+    auto alarms = dds::Reader<msg::OperatorAlarm>::create(
+        *participant_, logical_agent::kAlarmTopic,
+        [this](const msg::OperatorAlarm& alarm) {
+          std::lock_guard lock(seen_.mutex);
+          seen_.alarms.push_back(alarm);
+          seen_.changed.notify_all();
+        },
+        events);
+    ASSERT_TRUE(alarms.has_value());
+    alarms_ = std::move(*alarms);
+    auto timelines = dds::Reader<msg::TimelineState>::create(
+        *participant_, "drover/topology/timeline", [this](const msg::TimelineState& state) { on_timeline(state); });
+    ASSERT_TRUE(timelines.has_value());
+    timelines_ = std::move(*timelines);
+    for (const auto& vehicle : vehicles) {
+      auto client = ran::RanClient::create(*participant_, vehicle, {}, 16,
+                                           [this](const ran::VehicleStatus& status) { on_status(status); });
+      ASSERT_TRUE(client.has_value()) << client.error().message;
+      rans_[vehicle] = std::move(*client);
+    }
+    auto orders = dds::ServiceClient<msg::OrderRequest, msg::OrderReply>::create(
+        *participant_, logical_agent::kServiceArea, logical_agent::kOrderService);
+    ASSERT_TRUE(orders.has_value());
+    order_client_ = std::move(*orders);
+  }
+
+  void TearDown() override {
+    order_client_.reset();
+    rans_.clear();
+    timelines_.reset();
+    alarms_.reset();
+    notices_.reset();
+    progress_.reset();
+    participant_.reset();
+  }
+
+  void on_timeline(const msg::TimelineState& state) {
+    std::lock_guard lock(seen_.mutex);
+    seen_.holders[state.entity()] = state.holder();
+    seen_.holder_log[state.entity()].emplace_back(clock_->now(), state.holder());
+    if (state.holder().empty()) return;
+    const auto entity = world_->find(state.entity());
+    if (!entity) return;
+    for (const auto other : world_->conflicts(*entity)) {
+      const auto& holder = seen_.holders[world_->id(other)];
+      if (!holder.empty() && holder != state.holder()) {
+        seen_.hold_violations.push_back(state.holder() + " holds " + state.entity() + " while " + holder +
+                                        " holds " + world_->id(other));
+      }
+    }
+  }
+
+  void on_status(const ran::VehicleStatus& status) {
+    std::lock_guard lock(seen_.mutex);
+    seen_.latest[status.vehicle_id] = status;
+    for (const auto& [other, other_status] : seen_.latest) {
+      if (other == status.vehicle_id) continue;
+      std::vector<topology::Polygon> common;
+      bg::intersection(status.footprint, other_status.footprint, common);
+      double area = 0;
+      for (const auto& part : common) area += bg::area(part);
+      if (area > 1e-6) {
+        seen_.overlaps.push_back(status.vehicle_id + " and " + other + " overlap by " + std::to_string(area) + " m^2");
+      }
+    }
+    const bool on = bg::intersects(status.footprint, world_->footprint(*world_->find("bar-2")));
+    auto& spans = seen_.on_bar[status.vehicle_id];
+    if (on) {
+      if (spans.empty() || spans.back().second != 0) spans.emplace_back(status.time, 0);
+    } else if (!spans.empty() && spans.back().second == 0) {
+      spans.back().second = status.time;
+    }
+    seen_.changed.notify_all();
+  }
+
+  /// Sends an order; \return the reply's error message ("" when queued).
+  std::string send_order(const std::string& vehicle, const std::string& name,
+                         const std::vector<std::pair<std::string, std::string>>& destinations) {
+    msg::OrderRequest request;
+    request.order(name);
+    for (const auto& [location, operation] : destinations) {
+      msg::OrderDestination destination;
+      destination.location(location);
+      destination.operation(operation);
+      request.destinations().push_back(destination);
+    }
+    auto reply = order_client_->call(request, 60s, vehicle);
+    if (!reply) return reply.error().message;
+    return reply->error().code() == msg::ERROR_NONE ? "" : reply->error().message();
+  }
+
+  /// Waits until the order ended. \return its last progress.
+  std::optional<msg::OrderProgress> wait_order(const std::string& name) {
+    std::optional<msg::OrderProgress> out;
+    seen_.wait(
+        [&] {
+          auto found = seen_.orders.find(name);
+          if (found == seen_.orders.end()) return false;
+          if (found->second.state() != msg::ORDER_FINISHED && found->second.state() != msg::ORDER_FAILED) return false;
+          out = found->second;
+          return true;
+        },
+        std::chrono::duration_cast<std::chrono::seconds>(kRunTimeout));
+    return out;
+  }
+
+  /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
+  bool wait_ready(const std::string& vehicle, const std::string& vertex) {
+    return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
+  }
+
+  std::shared_ptr<topology::Topology> world_;
+  std::optional<SharedClock> clock_;
+  Observations seen_;
+  std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_;
+  std::unique_ptr<dds::Reader<msg::ReservationNotice>> notices_;
+  std::unique_ptr<dds::Reader<msg::OperatorAlarm>> alarms_;
+  std::unique_ptr<dds::Reader<msg::TimelineState>> timelines_;
+  std::map<std::string, std::unique_ptr<ran::RanClient>> rans_;
+  std::unique_ptr<dds::ServiceClient<msg::OrderRequest, msg::OrderReply>> order_client_;
+};
+
+TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
+  constexpr std::uint32_t kDomain = 186;
+  Fleet fleet(kDomain, "crossing");
+  fleet.start_infrastructure();
+  fleet.start_vehicle("V1", "left-0");
+  fleet.start_vehicle("V2", "right-0");
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
+
+  // V1 through droverctl, as an operator would; V2 directly.
+  auto droverctl = ChildProcess::spawn(binary_path("droverctl"),
+                                       {"order", "send", "V1", "right-4:NOP", "--name", "v1-cross", "--domain",
+                                        std::to_string(kDomain), "--timeout", "60"});
+  ASSERT_TRUE(droverctl.has_value());
+  const auto sent = droverctl->wait_exit(90s);
+  ASSERT_TRUE(sent.has_value());
+  ASSERT_EQ(sent->code, 0);
+  ASSERT_EQ(send_order("V2", "v2-cross", {{"left-4", "NOP"}}), "");
+
+  const auto first = wait_order("v1-cross");
+  const auto second = wait_order("v2-cross");
+  ASSERT_TRUE(first && second) << "an order did not end: deadlock?";
+  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
+  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
+  EXPECT_EQ(first->destination(), 1u);
+
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
+  // Both crossed the bar's middle, one after the other.
+  const auto& v1 = seen_.on_bar["V1"];
+  const auto& v2 = seen_.on_bar["V2"];
+  ASSERT_EQ(v1.size(), 1u);
+  ASSERT_EQ(v2.size(), 1u);
+  const auto& earlier = v1.front().first < v2.front().first ? v1.front() : v2.front();
+  const auto& later = v1.front().first < v2.front().first ? v2.front() : v1.front();
+  EXPECT_NE(earlier.second, 0) << "the earlier vehicle never left bar-2";
+  EXPECT_GE(later.first, earlier.second) << "the later vehicle entered bar-2 before the earlier left it";
+  // The vehicles end where they were sent, holding their destination.
+  EXPECT_EQ(seen_.holders["right-4"], "V1");
+  EXPECT_EQ(seen_.holders["left-4"], "V2");
+}
+
+TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
+  constexpr std::uint32_t kDomain = 187;
+  Fleet fleet(kDomain, "stall");
+  fleet.start_infrastructure();
+  fleet.start_vehicle("V1", "left-0");
+  fleet.start_vehicle("V2", "right-0");
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_EQ(send_order("V1", "v1-stall", {{"right-4", "NOP"}}), "");
+  ASSERT_EQ(send_order("V2", "v2-stall", {{"left-4", "NOP"}}), "");
+
+  // Stall V1 as soon as it drives on the bar (ahead of V2, which waits for it).
+  ASSERT_TRUE(seen_.wait(
+      [&] {
+        auto found = seen_.latest.find("V1");
+        return found != seen_.latest.end() && found->second.pose.x > 1.5 && found->second.pose.x < 8;
+      },
+      120s))
+      << "V1 never reached the bar";
+  std::size_t notices_before = 0;
+  {
+    std::lock_guard lock(seen_.mutex);
+    notices_before = seen_.notices.size();
+  }
+  ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::stall, seconds_to_ns(10), 10s));
+
+  // V1 propagates a delay; V2's reservations are pushed (it is told and follows).
+  EXPECT_TRUE(seen_.wait(
+      [&] {
+        bool v1 = false;
+        bool v2 = false;
+        for (std::size_t i = notices_before; i < seen_.notices.size(); ++i) {
+          const auto& notice = seen_.notices[i];
+          if (notice.kind() != msg::NOTICE_SHIFTED) continue;
+          v1 = v1 || notice.agent() == "V1";
+          v2 = v2 || notice.agent() == "V2";
+        }
+        return v1 && v2;
+      },
+      120s))
+      << "no delay of V1 pushing V2 was seen";
+
+  const auto first = wait_order("v1-stall");
+  const auto second = wait_order("v2-stall");
+  ASSERT_TRUE(first && second) << "an order did not end: deadlock?";
+  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
+  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  const auto& v1 = seen_.on_bar["V1"];
+  const auto& v2 = seen_.on_bar["V2"];
+  ASSERT_EQ(v1.size(), 1u);
+  ASSERT_EQ(v2.size(), 1u);
+  EXPECT_GE(v2.front().first, v1.front().second) << "V2 overtook the stalled V1 on bar-2";
+}
+
+TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
+  constexpr std::uint32_t kDomain = 188;
+  Fleet fleet(kDomain, "lock");
+  fleet.start_infrastructure();
+  fleet.start_vehicle("V1", "left-0");
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "v1-lock", {{"right-4", "NOP"}}), "");
+  // Once V1 has its route (it moves), lock bar-3 ahead of it for 30 s.
+  ASSERT_TRUE(seen_.wait(
+      [&] {
+        auto found = seen_.latest.find("V1");
+        return found != seen_.latest.end() && found->second.pose.y > 0.5;
+      },
+      120s));
+  auto lock_client = dds::ServiceClient<msg::LockRequest, msg::LockReply>::create(*participant_, "topology", "lock");
+  ASSERT_TRUE(lock_client.has_value());
+  msg::LockRequest lock;
+  lock.entity("bar-3");
+  const TimeNs lock_start = clock_->now();
+  const TimeNs lock_end = lock_start + seconds_to_ns(30);
+  lock.window().start(lock_start);
+  lock.window().end(lock_end);
+  lock.operator_id("tester");
+  lock.reason("broken floor plate");
+  auto locked = (*lock_client)->call(lock, 10s);
+  ASSERT_TRUE(locked.has_value());
+  ASSERT_EQ(locked->error().code(), msg::ERROR_NONE) << locked->error().message();
+  bool hit_v1 = false;
+  for (const auto& reservation : locked->hit()) hit_v1 = hit_v1 || reservation.agent() == "V1";
+  ASSERT_TRUE(hit_v1) << "the lock did not hit V1's planned route";
+
+  const auto done = wait_order("v1-lock");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FINISHED) << done->failure();
+  std::lock_guard guard(seen_.mutex);
+  bool notified = false;
+  for (const auto& notice : seen_.notices) notified = notified || (notice.kind() == msg::NOTICE_LOCK_HIT && notice.agent() == "V1");
+  EXPECT_TRUE(notified);
+  // V1 was never allocated bar-3 while it was locked, but drove over it afterwards.
+  bool held_after = false;
+  for (const auto& [time, holder] : seen_.holder_log["bar-3"]) {
+    if (holder != "V1") continue;
+    EXPECT_GE(time, lock_end) << "V1 held bar-3 during the lock";
+    held_after = true;
+  }
+  EXPECT_TRUE(held_after);
+  EXPECT_EQ(seen_.holders["right-4"], "V1");
+}
+
+}  // namespace
+}  // namespace drover::test
