@@ -93,8 +93,8 @@ void print_summary(const launcher::LaunchFile& file, DurationNs ran_for,
   std::cout << fmt::format("  orders finished: {}\n  orders failed:   {}\n  orders open:     {}\n",
                            figures.orders.finished, figures.orders.failed, figures.orders.open);
   std::cout << fmt::format("  mean lead time:  {}\n", lead_time_text(figures.orders));
-  std::cout << fmt::format("  vehicles:        {} reporting, {} RAN statuses\n", figures.vehicles_reporting,
-                           figures.statuses);
+  std::cout << fmt::format("  vehicles:        {} reporting, {} RAN statuses, {} topology events\n",
+                           figures.vehicles_reporting, figures.statuses, figures.topology_events);
   for (const auto& agent : outcome.agents) {
     if (agent.restarts == 0 && !agent.failed) continue;
     std::cout << fmt::format("  agent {}: {} restart(s){}; last failure: {}\n", agent.id, agent.restarts,
@@ -176,6 +176,14 @@ int run(const LaunchArguments& arguments) {
                             "--time-factor",  fmt::format("{}", file->time_factor),
                             "--epoch",        std::to_string(epoch),
                             "--clock-origin", std::to_string(origin)};
+  // The fleet's figures when the stop is asked for: agents being stopped end their orders
+  // as failed ("shutting down"), which says nothing about the run.
+  launcher::FleetFigures figures;
+  TimeNs stopped_at = epoch;
+  options.before_stop = [&] {
+    figures = (*monitor)->figures();
+    stopped_at = clock->now();
+  };
   launcher::Console console;
   console.note(fmt::format("{}: {} agents on domain {}, time factor {}, state in {}", file->path.string(),
                            file->agents.size(), file->domain_id, file->time_factor,
@@ -194,13 +202,12 @@ int run(const LaunchArguments& arguments) {
     std::cerr << "error: " << outcome.error().message << "\n";
     return kExitFailure;
   }
-  const auto figures = (*monitor)->figures();
+  const auto statuses = (*monitor)->figures();
+  figures.statuses = statuses.statuses;
+  figures.topology_events = statuses.topology_events;
   monitor->reset();
   participant->reset();
   if (trace) trace->flush();
-  // The simulated time at which the stop was asked for, not after the agents ended.
-  const TimeNs stopped_at =
-      clock->now() - clock->to_sim(std::chrono::steady_clock::now() - outcome->stop_requested_at);
   print_summary(*file, stopped_at - epoch, figures, *outcome, trace.get(), arguments.trace_file);
   return outcome->any_failed() ? kExitFailure : kExitOk;
 }

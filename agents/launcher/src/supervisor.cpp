@@ -108,7 +108,7 @@ Result<SupervisorOutcome> Supervisor::run(const Tick& tick) {
       if (auto reason = tick()) outcome.stop_reason = *reason;
     }
   }
-  outcome.stop_requested_at = Clock::now();
+  if (options_.before_stop) options_.before_stop();
   console_.note("stopping (" + outcome.stop_reason + ")");
   bool kill_now = false;
   stop_all(kill_now);

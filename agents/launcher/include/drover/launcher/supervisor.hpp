@@ -28,6 +28,9 @@ struct SupervisorOptions {
   std::chrono::milliseconds restart_delay{1000};
   /// How often the tick is called.
   std::chrono::milliseconds tick_period{250};
+  /// Called once when the stop is asked for, before any agent is stopped (the launcher
+  /// takes its figures there: agents that are being stopped fail their work).
+  std::function<void()> before_stop;
 };
 
 /// How one agent ended up.
@@ -46,8 +49,6 @@ struct AgentOutcome {
 struct SupervisorOutcome {
   /// What made it stop: "signal SIGINT", "signal SIGTERM" or the tick's reason.
   std::string stop_reason;
-  /// When the stop was asked for (before the agents were stopped).
-  std::chrono::steady_clock::time_point stop_requested_at;
   std::vector<AgentOutcome> agents;
 
   bool any_failed() const;
