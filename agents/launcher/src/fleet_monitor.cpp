@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "agents/topology_agent/topology_agent.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
 #include "drover/ran_runner/names.hpp"
@@ -65,6 +66,31 @@ nlohmann::json order_line(const msg::OrderProgress& progress) {
           {"failure", progress.failure()}};
 }
 
+const char* event_name(msg::TopologyEventKind kind) {
+  switch (kind) {
+    case msg::EVENT_RESERVED: return "reservation";
+    case msg::EVENT_ABORTED: return "abort";
+    case msg::EVENT_EXPIRED: return "expiry";
+    case msg::EVENT_ALLOCATED: return "allocation";
+    case msg::EVENT_RELEASED: return "release";
+    case msg::EVENT_CANCELLED: return "cancel";
+    case msg::EVENT_LOCKED: return "lock";
+    case msg::EVENT_UNLOCKED: return "unlock";
+    case msg::EVENT_DELAYED: return "delay";
+  }
+  return "unknown";
+}
+
+nlohmann::json event_line(const msg::TopologyEvent& event) {
+  // An open end (kForever) is written as null: JSON readers need not know the sentinel.
+  // Route ids are 64-bit: written as strings, which every JSON reader keeps exact.
+  const auto end = event.window().end() == kForever ? nlohmann::json(nullptr) : nlohmann::json(event.window().end());
+  return {{"source", event.source()},  {"serial", event.serial()},   {"event", event_name(event.kind())},
+          {"agent", event.agent()},    {"route", std::to_string(event.route())},     {"step", event.step()},
+          {"entity", event.entity()},  {"window", {event.window().start(), end}},
+          {"shift", event.shift()},    {"lock_id", event.lock_id()}, {"reason", event.reason()}};
+}
+
 }  // namespace
 
 Result<std::unique_ptr<FleetMonitor>> FleetMonitor::create(dds::Participant& participant, TraceWriter* trace) {
@@ -86,11 +112,18 @@ Result<std::unique_ptr<FleetMonitor>> FleetMonitor::create(dds::Participant& par
       [self](const msg::OrderProgress& update) { self->on_progress(update); }, progress_options);
   if (!progress) return unexpected(progress.error());
   monitor->progress_reader_ = std::move(*progress);
+  auto events = dds::Reader<msg::TopologyEvent>::create(
+      participant, topology_agent::kEventTopic,
+      [self](const msg::TopologyEvent& event) { self->on_topology_event(event); },
+      dds::ReaderOptions{dds::TopicQos::events(), {}, {}});
+  if (!events) return unexpected(events.error());
+  monitor->event_reader_ = std::move(*events);
   return monitor;
 }
 
 FleetMonitor::~FleetMonitor() {
   // Readers first: their callbacks use the rest.
+  event_reader_.reset();
   progress_reader_.reset();
   status_reader_.reset();
 }
@@ -110,6 +143,12 @@ void FleetMonitor::on_progress(const msg::OrderProgress& progress) {
   if (trace_ != nullptr) trace_->write(progress_time(progress), "order", order_line(progress));
   std::lock_guard lock(mutex_);
   orders_.update(progress.order(), outcome, time_of(progress.created()), time_of(progress.finished()));
+}
+
+void FleetMonitor::on_topology_event(const msg::TopologyEvent& event) {
+  if (trace_ != nullptr) trace_->write(event.time(), "topology_event", event_line(event));
+  std::lock_guard lock(mutex_);
+  ++topology_events_;
 }
 
 FleetFigures FleetMonitor::figures() const {

@@ -16,6 +16,7 @@
 #include "drover/launcher/trace_writer.hpp"
 #include "logical.h"
 #include "ran.h"
+#include "topology.h"
 
 namespace drover::launcher {
 
@@ -42,6 +43,7 @@ class FleetMonitor {
   explicit FleetMonitor(TraceWriter* trace) : trace_(trace) {}
   void on_status(const msg::RanStatus& status);
   void on_progress(const msg::OrderProgress& progress);
+  void on_topology_event(const msg::TopologyEvent& event);
 
   TraceWriter* trace_;
   mutable std::mutex mutex_;
@@ -51,6 +53,7 @@ class FleetMonitor {
   std::uint64_t topology_events_ = 0;
   std::unique_ptr<dds::Reader<msg::RanStatus>> status_reader_;
   std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_reader_;
+  std::unique_ptr<dds::Reader<msg::TopologyEvent>> event_reader_;
 };
 
 }  // namespace drover::launcher
