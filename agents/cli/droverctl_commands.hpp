@@ -15,4 +15,10 @@ void add_agents_command(CLI::App& app, CommandContext& context);
 /// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent.
 void add_order_command(CLI::App& app, CommandContext& context);
 
+/// `droverctl lock ENTITY --from T --until T --reason TEXT`, `droverctl unlock LOCK_ID`,
+/// `droverctl timeline ENTITY`: the topology agents' locks and timelines.
+void add_lock_command(CLI::App& app, CommandContext& context);
+void add_unlock_command(CLI::App& app, CommandContext& context);
+void add_timeline_command(CLI::App& app, CommandContext& context);
+
 }  // namespace drover::cli

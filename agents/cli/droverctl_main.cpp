@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
 
   CommandContext context;
   add_agents_command(app, context);
+  add_lock_command(app, context);
+  add_unlock_command(app, context);
+  add_timeline_command(app, context);
   add_order_command(app, context);
 
   try {
