@@ -5,6 +5,11 @@
 // plain DataReader on drover/bench/raw/ping whose listener writes each sample straight back
 // on drover/bench/raw/pong. The client alternates one raw round trip and one service call
 // with the same payload, so that both see the same machine load, and prints one JSON line.
+//
+// With --route, the service measured is the routing agent's route service instead of the
+// ping echo: the benchmark also starts `drover topology-agent` (the whole --topology) and
+// `drover routing-agent` as processes and times test-route requests FROM -> TO, against
+// raw ping-pongs whose payload is the serialized size of the route reply.
 
 #include "bench/bench_rpc.hpp"
 
@@ -24,6 +29,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -33,6 +39,7 @@
 #include <fmt/format.h>
 
 #include "diagnostics.h"
+#include "routing.h"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/qos.hpp"
 #include "drover/dds/service_client.hpp"
@@ -50,6 +57,7 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 using PingClient = dds::ServiceClient<msg::PingRequest, msg::PingReply>;
 using PingServer = dds::ServiceServer<msg::PingRequest, msg::PingReply>;
+using RouteClient = dds::ServiceClient<msg::RouteRequest, msg::RouteReply>;
 
 constexpr const char* kRawPingTopic = "drover/bench/raw/ping";
 constexpr const char* kRawPongTopic = "drover/bench/raw/pong";
@@ -62,6 +70,11 @@ struct RpcArguments {
   int calls = 2000;
   int warmup = 200;
   std::size_t payload_bytes = 512;
+  /// Route mode: the topology file and the test route measured.
+  bool route = false;
+  std::string topology_file = "launch/topologies/warehouse.json";
+  std::string route_from = "aisle-00-y08";
+  std::string route_to = "aisle-02-y20";
 };
 
 /// A raw DataReader with its listener; deleted before the participant.
@@ -206,11 +219,12 @@ int run_server(const RpcArguments& arguments) {
   return cli::kExitOk;
 }
 
-/// The child process running `drover bench rpc-server`; SIGTERM and reaped on destruction.
+/// A child process running `drover ARGS...` (the rpc-server, or an agent); SIGTERM and
+/// reaped on destruction.
 class ServerProcess {
  public:
-  static std::optional<ServerProcess> start(std::uint32_t domain) {
-    std::vector<std::string> args{"drover", "bench", "rpc-server", "--domain", std::to_string(domain)};
+  static std::optional<ServerProcess> start(std::vector<std::string> args) {
+    args.insert(args.begin(), "drover");
     std::vector<char*> argv;
     for (auto& arg : args) argv.push_back(arg.data());
     argv.push_back(nullptr);
@@ -241,9 +255,72 @@ double micros_since(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+/// In route mode: the topology agent and the routing agent processes, the route client,
+/// and the test route it asks for.
+struct RouteTarget {
+  std::vector<ServerProcess> agents;
+  std::unique_ptr<RouteClient> client;
+  msg::RouteRequest request;
+  std::size_t request_bytes = 0;
+  std::size_t reply_bytes = 0;
+  std::size_t steps = 0;
+};
+
+/// Starts the agents and asks for the test route until it comes back (the routing agent
+/// learns the topology first). \return the target, or the exit code.
+std::variant<RouteTarget, int> start_route_target(const RpcArguments& arguments, dds::Participant& participant) {
+  RouteTarget target;
+  const std::string domain = std::to_string(arguments.domain_id);
+  for (std::vector<std::string> args :
+       {std::vector<std::string>{"topology-agent", "--topology", arguments.topology_file, "--domain", domain,
+                                 "--id", "bench-topology", "--log-level", "warn"},
+        std::vector<std::string>{"routing-agent", "--domain", domain, "--id", "bench-routing", "--log-level",
+                                 "warn"}}) {
+    auto process = ServerProcess::start(args);
+    if (!process) {
+      std::cerr << "error: cannot start drover " << args.front() << "\n";
+      return cli::kExitFailure;
+    }
+    target.agents.push_back(std::move(*process));
+  }
+  auto client = RouteClient::create(participant, "routing", "route");
+  if (!client) {
+    std::cerr << "error: " << client.error().message << "\n";
+    return cli::kExitFailure;
+  }
+  target.client = std::move(*client);
+  msg::RouteRequest& request = target.request;
+  request.agent("bench-vehicle");
+  request.real(false);
+  request.vehicle().id("bench-vehicle");
+  request.vehicle().max_speed(1.0);
+  request.vehicle().acceleration(1.0);
+  request.vehicle().deceleration(1.0);
+  request.vehicle().length(1.0);
+  request.vehicle().width(1.0);
+  request.start(arguments.route_from);
+  msg::RouteStop stop;
+  stop.vertex(arguments.route_to);
+  request.stops().push_back(stop);
+  auto reply = target.client->call(request, kStartTimeout);
+  if (!reply) {
+    std::cerr << "error: the routing agent did not answer: " << reply.error().message << "\n";
+    return cli::kExitNoAnswer;
+  }
+  if (reply->error().code() != msg::ERROR_NONE) {
+    std::cerr << "error: test route " << arguments.route_from << " -> " << arguments.route_to << ": "
+              << reply->error().message() << "\n";
+    return cli::kExitBadInput;
+  }
+  target.request_bytes = msg::RouteRequest::getCdrSerializedSize(request);
+  target.reply_bytes = msg::RouteReply::getCdrSerializedSize(*reply);
+  target.steps = reply->steps().size();
+  return target;
+}
+
 /// The measured run; \return the exit code.
 int run_benchmark(const RpcArguments& arguments) {
-  auto server_process = ServerProcess::start(arguments.domain_id);
+  auto server_process = ServerProcess::start({"bench", "rpc-server", "--domain", std::to_string(arguments.domain_id)});
   if (!server_process) {
     std::cerr << "error: cannot start the rpc-server process\n";
     return cli::kExitFailure;
@@ -266,8 +343,18 @@ int run_benchmark(const RpcArguments& arguments) {
     return cli::kExitNoAnswer;
   }
 
+  std::optional<RouteTarget> route;
+  std::size_t payload_bytes = arguments.payload_bytes;
+  if (arguments.route) {
+    auto started = start_route_target(arguments, *participant);
+    if (auto* code = std::get_if<int>(&started)) return *code;
+    route.emplace(std::move(std::get<RouteTarget>(started)));
+    // The raw ping carries what the route reply carries (the larger of the two messages).
+    payload_bytes = route->reply_bytes;
+  }
+
   msg::PingRequest request;
-  request.payload(std::vector<std::uint8_t>(arguments.payload_bytes, 0x5a));
+  request.payload(std::vector<std::uint8_t>(payload_bytes, 0x5a));
   const std::vector<std::uint8_t> payload = request.payload();
 
   // Raw readiness: a raw ping written before the server's reader has matched ours is lost
@@ -296,14 +383,26 @@ int run_benchmark(const RpcArguments& arguments) {
     }
     const double raw = micros_since(raw_start);
 
-    request.text("service-" + std::to_string(i));
-    const auto service_start = Clock::now();
-    auto reply = (*client)->call(request, kCallTimeout);
-    const double service = micros_since(service_start);
-    if (!reply || reply->payload() != payload) {
-      std::cerr << "error: service call " << i << ": "
-                << (reply ? "payload not echoed" : reply.error().message) << "\n";
-      return cli::kExitFailure;
+    double service = 0;
+    if (route) {
+      const auto service_start = Clock::now();
+      auto reply = route->client->call(route->request, kCallTimeout);
+      service = micros_since(service_start);
+      if (!reply || reply->error().code() != msg::ERROR_NONE || reply->steps().size() != route->steps) {
+        std::cerr << "error: route request " << i << ": "
+                  << (reply ? reply->error().message() : reply.error().message) << "\n";
+        return cli::kExitFailure;
+      }
+    } else {
+      request.text("service-" + std::to_string(i));
+      const auto service_start = Clock::now();
+      auto reply = (*client)->call(request, kCallTimeout);
+      service = micros_since(service_start);
+      if (!reply || reply->payload() != payload) {
+        std::cerr << "error: service call " << i << ": "
+                  << (reply ? "payload not echoed" : reply.error().message) << "\n";
+        return cli::kExitFailure;
+      }
     }
     if (i >= 0) {
       raw_us.push_back(raw);
@@ -315,6 +414,18 @@ int run_benchmark(const RpcArguments& arguments) {
   const double raw_p99 = percentile_us(raw_us, 0.99);
   const double service_p50 = percentile_us(service_us, 0.50);
   const double service_p99 = percentile_us(service_us, 0.99);
+  if (route) {
+    std::cout << fmt::format(
+                     "{{\"benchmark\": \"rpc-route\", \"route\": \"{} -> {}\", \"route_steps\": {}, "
+                     "\"request_bytes\": {}, \"reply_bytes\": {}, \"payload_bytes\": {}, \"calls\": {}, "
+                     "\"raw_p50_us\": {:.1f}, \"raw_p99_us\": {:.1f}, \"route_p50_us\": {:.1f}, "
+                     "\"route_p99_us\": {:.1f}, \"ratio_p50\": {:.3f}, \"ratio_p99\": {:.3f}}}",
+                     arguments.route_from, arguments.route_to, route->steps, route->request_bytes,
+                     route->reply_bytes, payload_bytes, arguments.calls, raw_p50, raw_p99, service_p50, service_p99,
+                     service_p50 / raw_p50, service_p99 / raw_p99)
+              << std::endl;
+    return cli::kExitOk;
+  }
   std::cout << fmt::format(
                    "{{\"benchmark\": \"rpc\", \"payload_bytes\": {}, \"calls\": {}, \"raw_p50_us\": {:.1f}, "
                    "\"raw_p99_us\": {:.1f}, \"service_p50_us\": {:.1f}, \"service_p99_us\": {:.1f}, "
@@ -338,6 +449,14 @@ void add_bench_rpc_command(CLI::App& bench, cli::CommandContext& context) {
       ->check(CLI::Range(0, 1'000'000));
   rpc->add_option("--payload", arguments->payload_bytes, "Payload bytes per request (default 512)")
       ->check(CLI::Range(0, 1'000'000));
+  rpc->add_flag("--route", arguments->route,
+                "Measure the routing agent's route service (test routes) instead of the ping echo; starts a "
+                "topology agent and a routing agent");
+  rpc->add_option("--topology", arguments->topology_file,
+                  "Route mode: topology the agents serve (default launch/topologies/warehouse.json)")
+      ->check(CLI::ExistingFile);
+  rpc->add_option("--from", arguments->route_from, "Route mode: start vertex (default aisle-00-y08)");
+  rpc->add_option("--to", arguments->route_to, "Route mode: destination vertex (default aisle-02-y20)");
   rpc->callback([arguments, &context] { context.exit_code = run_benchmark(*arguments); });
 
   // The partner process; started by `rpc` itself, so hidden from the help.

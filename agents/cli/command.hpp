@@ -19,11 +19,20 @@ struct CommandContext {
   int exit_code = kExitOk;
 };
 
+/// Parses the command line into `app` and runs the chosen subcommand. Help and version
+/// requests print and exit 0; a parse error prints CLI11's message and gives kExitBadInput;
+/// an exception escaping a command (commands report expected failures themselves) prints
+/// "error: internal: ..." and gives kExitFailure. \return the exit code of the process.
+int run_app(CLI::App& app, const CommandContext& context, int argc, char** argv);
+
 /// `drover topology ...` (validate and friends).
 void add_topology_commands(CLI::App& app, CommandContext& context);
 
 /// `drover topology-agent`: a topology agent process (agents/topology_agent/).
 void add_topology_agent_command(CLI::App& app, CommandContext& context);
+
+/// `drover routing-agent`: a routing agent process (agents/routing_agent/).
+void add_routing_agent_command(CLI::App& app, CommandContext& context);
 
 /// `drover logical-agent`: the logical agent of one vehicle (agents/logical_agent/).
 void add_logical_agent_command(CLI::App& app, CommandContext& context);

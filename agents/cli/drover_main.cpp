@@ -1,8 +1,5 @@
 // `drover`: the one executable of Drover; every agent and tool is a subcommand.
 
-#include <exception>
-#include <iostream>
-
 #include <CLI/CLI.hpp>
 
 #include "agents/cli/command.hpp"
@@ -18,28 +15,12 @@ int main(int argc, char** argv) {
   CommandContext context;
   add_topology_commands(app, context);
   add_topology_agent_command(app, context);
+  add_routing_agent_command(app, context);
   add_ran_commands(app, context);
   add_logical_agent_command(app, context);
   add_launch_command(app, context);
   add_load_generator_command(app, context);
   drover::bench::add_bench_commands(app, context);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    // Commands turn expected failures into messages themselves; this is the last guard so
-    // that nothing ever ends in an uncaught exception.
-    std::cerr << "error: internal: " << e.what() << "\n";
-    return kExitFailure;
-  }
-  return context.exit_code;
+  return run_app(app, context, argc, argv);
 }

@@ -12,6 +12,9 @@ namespace drover::cli {
 /// `droverctl agents`: the live agents, from their heartbeats.
 void add_agents_command(CLI::App& app, CommandContext& context);
 
+/// `droverctl route FROM TO`: a test or real route from a routing agent, as JSON.
+void add_route_command(CLI::App& app, CommandContext& context);
+
 /// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent.
 void add_order_command(CLI::App& app, CommandContext& context);
 

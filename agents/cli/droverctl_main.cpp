@@ -1,8 +1,5 @@
 // `droverctl`: the operator tool. Each command is a subcommand (agents_command.cpp, ...).
 
-#include <exception>
-#include <iostream>
-
 #include <CLI/CLI.hpp>
 
 #include "agents/cli/droverctl_commands.hpp"
@@ -19,22 +16,7 @@ int main(int argc, char** argv) {
   add_unlock_command(app, context);
   add_timeline_command(app, context);
   add_order_command(app, context);
+  add_route_command(app, context);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    // Commands turn expected failures into messages themselves; this is the last guard.
-    std::cerr << "error: internal: " << e.what() << "\n";
-    return kExitFailure;
-  }
-  return context.exit_code;
+  return run_app(app, context, argc, argv);
 }

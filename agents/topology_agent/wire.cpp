@@ -55,6 +55,7 @@ msg::EntityDescription to_wire_description(const topology::Topology& topology,
     out.vertex_kind(topology::to_string(vertex.kind));
     out.position(to_wire(vertex.position));
     out.orientation(to_wire(vertex.orientation));
+    for (const auto& move : topology.moves_from(entity)) out.out_edges().push_back(topology.id(move.edge));
   } else {
     const auto& edge = topology.edge(entity);
     out.kind(msg::ENTITY_EDGE);

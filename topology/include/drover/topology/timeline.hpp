@@ -349,6 +349,17 @@ class TimelineSet {
   /// Removes a lock. not_found if unknown.
   Status unlock(LockId id);
 
+  // ---- replicas (timeline_replica.cpp) ----
+
+  /// For a replica (a routing agent mirroring the timelines its topology agents publish):
+  /// sets the owned entity's timeline to the one its owner published, version included.
+  /// The holder, if any, is taken to hold its first committed real reservation there (the
+  /// one allocate grants). Nothing else is checked: the owner enforces the invariants and
+  /// checks every prepare against the versions the replica had. Held (prepared) items
+  /// block others like any reservation but make no prepared set here.
+  /// \return not_found for an entity not owned.
+  Status replace_timeline(EntityIndex entity, Timeline timeline);
+
   // ---- persistence (timeline_snapshot.cpp) ----
 
   /// The committed state of every owned entity that is not empty at version 0 (see

@@ -1,0 +1,22 @@
+// TimelineSet::replace_timeline: how a routing agent's replica takes in a published timeline.
+
+#include "timeline_impl.hpp"
+
+namespace drover::topology {
+
+Status TimelineSet::replace_timeline(EntityIndex entity, Timeline timeline) {
+  if (!owns(entity)) {
+    return fail(ErrorCode::not_found,
+                "replace_timeline: entity " + std::to_string(entity) + " is not owned by this set");
+  }
+  held_[entity].reset();
+  if (timeline.holder) {
+    if (const Reservation* held = Impl::first_committed_real(timeline, *timeline.holder)) {
+      held_[entity] = AllocatedStep{held->route, held->step};
+    }
+  }
+  timelines_[entity] = std::move(timeline);
+  return {};
+}
+
+}  // namespace drover::topology
