@@ -290,11 +290,34 @@ void TopologyAgent::on_abort(const msg::ReserveAbortRequest& request, StatusHand
   send_status(reply, aborted);
 }
 
+bool TopologyAgent::locked_now(topology::EntityIndex entity) const {
+  const TimeNs now = clock_.now();
+  const auto in_force = [&](topology::EntityIndex e) {
+    if (!timelines_.owns(e)) return false;
+    const auto& locks = timelines_.timeline(e).locks;
+    return std::any_of(locks.begin(), locks.end(),
+                       [&](const topology::Lock& lock) { return lock.window.start <= now && now < lock.window.end; });
+  };
+  if (in_force(entity)) return true;
+  const auto conflicts = topology_.conflicts(entity);
+  return std::any_of(conflicts.begin(), conflicts.end(), in_force);
+}
+
 void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHandle reply) {
   std::lock_guard lock(mutex_);
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
   const bool held_before = timelines_.timeline(*entity).holder == request.agent();
+  // A lock in force now on the entity or its conflict set keeps everyone off it (I4),
+  // whatever the reservation order says: a vehicle running early on a route planned around
+  // the lock must not be let on. Not queued: the requester asks again (no grant comes when
+  // a lock ends).
+  if (!held_before && locked_now(*entity)) {
+    msg::AllocateReply out;
+    out.granted(false);
+    out.queue_position(0);
+    return send_reply(reply, std::move(out));
+  }
   auto allocation = timelines_.allocate(request.agent(), *entity);
   if (!allocation) return send_error(reply, allocation.error());
   // A grant made now is reported like a deferred one (NOTICE_ALLOCATION_GRANTED aside).
@@ -497,6 +520,12 @@ Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants,
       return saved;
     }
   }
+  // Entities nobody holds first: a release that grants a conflicting entity to a waiting
+  // agent changes both in one step, and an observer reading the states in publication order
+  // must never see the new holder while the old one still shows as holding.
+  std::stable_partition(changed.begin(), changed.end(), [&](topology::EntityIndex entity) {
+    return !timelines_.timeline(entity).holder.has_value();
+  });
   for (auto entity : changed) {
     const auto& timeline = timelines_.timeline(entity);
     if (auto written = timeline_writer_->write(to_wire_timeline(topology_, agent_id(), entity, timeline));

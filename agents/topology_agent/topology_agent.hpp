@@ -113,6 +113,9 @@ class TopologyAgent {
   /// After the save, `events` (what the operation did) are published, then an
   /// EVENT_ALLOCATED for every grant; notify_grants false leaves out the grants' notices
   /// (the requester learns it from the reply).
+  /// Whether a lock on `entity` or a member of its conflict set is in force now. Requires
+  /// mutex_ held.
+  bool locked_now(topology::EntityIndex entity) const;
   Status after_change(const std::vector<topology::Grant>& grants, std::vector<msg::TopologyEvent> events = {},
                       bool notify_grants = true);
   void notify(msg::ReservationNotice notice);

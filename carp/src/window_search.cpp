@@ -68,17 +68,39 @@ DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
   return to_stop == kUnreachable ? kUnreachable : to_stop + leg.tail;
 }
 
+TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
+  const Leg& last = input.legs.back();
+  std::uint32_t count = 0;
+  const std::uint32_t first = windows_of(input, last.stop, count);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Interval w = windows_[first + i];
+    if (last.dwell == kForever ? w.end == kForever : w.end - w.start >= last.dwell) {
+      return w.start;
+    }
+  }
+  return input.start_time;
+}
+
+WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estimate,
+                                                 std::uint32_t state, std::uint32_t arc) {
+  return OpenEntry{std::max(ready + estimate, arrival_floor_), estimate, ready, sequence_++,
+                   state, arc};
+}
+
 void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
                            std::uint32_t parent, std::uint32_t arc, TimeNs edge_entry,
                            DurationNs estimate) {
   State& s = states_[state];
-  if (s.closed || ready >= s.ready) return;
+  if (ready >= s.ready) return;
+  // Keys clipped by the arrival floor are not consistent: a state may be closed before its
+  // best `ready` is known. It is then opened again (rare; the result stays exact).
+  s.closed = false;
   s.entry = entry;
   s.ready = ready;
   s.parent = parent;
   s.arc = arc;
   s.edge_entry = edge_entry;
-  open_.push(OpenEntry{ready + estimate, ready, sequence_++, state, kNone});
+  open_.push(open_entry(ready, estimate, state, kNone));
 }
 
 void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
@@ -136,6 +158,9 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   const std::uint32_t first = windows_of(input, input.start, count);
   if (count == 0 || windows_[first].start != input.start_time) return outcome;
   outcome.start_free = true;
+  // Every state's key is at least this: states that could only reach the goal before it
+  // is free would otherwise all be expanded first, in order of a bound that cannot be met.
+  arrival_floor_ = arrival_floor(input);
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
   improve(states_of(input, 0, input.start), input.start_time, input.start_time, kNone, kNone,
@@ -144,7 +169,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
     if (top.arc != kNone) {  // a deferred move: now look at the windows
-      drive(input, top.state, top.arc, top.f - top.ready, outcome);
+      drive(input, top.state, top.arc, top.h, outcome);
       continue;
     }
     State& popped = states_[top.state];
@@ -192,7 +217,7 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
       outcome.horizon_cut = true;
       continue;
     }
-    open_.push(OpenEntry{earliest + arc_estimate, earliest, sequence_++, index, a});
+    open_.push(open_entry(earliest, arc_estimate, index, a));
   }
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // The CARP search: A* over (stop layer, vertex, free window) states, ordered by the earliest
-// time the vehicle can leave the vertex plus the exact reservation-free time still to go.
+// time the vehicle can leave the vertex plus the exact reservation-free time still to go, or
+// by the earliest time the last stop can be held if that is later (both are lower bounds
+// of the arrival).
 //
 // A state (k, v, w) means: heading for stop k, the vehicle is on vertex v inside its free
 // window w, entered at `entry` and able to leave from `ready` on (entry, or entry + the
@@ -71,22 +73,29 @@ class WindowSearch {
   /// keyed by the earliest the move could arrive: the windows of the arc's edge and
   /// destination are looked up only if the search ever gets that far.
   struct OpenEntry {
-    TimeNs f;
+    TimeNs f;                // max(ready + h, arrival_floor_): a lower bound of the arrival
+    DurationNs h;            // the heuristic: reservation-free time still to go
     TimeNs ready;
     std::uint32_t sequence;  // push order
     std::uint32_t state;
     std::uint32_t arc;
-    /// Ties go to the later state, then to the newest entry: on grids many paths are
-    /// equally fast, and going deep along one spares exploring all of them.
+    /// Ties go to the entry closer to the goal (smaller h: without the floor, the later
+    /// state), then to the newest: on grids many paths are equally fast, and going deep
+    /// along one spares exploring all of them.
     bool operator>(const OpenEntry& o) const {
       if (f != o.f) return f > o.f;
-      if (ready != o.ready) return ready < o.ready;
+      if (h != o.h) return h > o.h;
       return sequence < o.sequence;
     }
   };
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
   void begin(const SearchInput& input);
+  /// The earliest the last stop can be reached and held (its first free window long
+  /// enough for the hold, or open-ended), from its free windows; input.start_time if none.
+  TimeNs arrival_floor(const SearchInput& input);
+  /// The open-list key of a state or move that could leave at `ready`, `estimate` to go.
+  OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state, std::uint32_t arc);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
                            std::uint32_t& count);
@@ -112,6 +121,7 @@ class WindowSearch {
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   std::uint32_t sequence_ = 0;
+  TimeNs arrival_floor_ = 0;  // no arrival at the last stop can be earlier (see arrival_floor)
   std::uint32_t goal_state_ = kNone;
 };
 

@@ -17,18 +17,17 @@
 #include <vector>
 
 #include <boost/geometry.hpp>
-#include <boost/geometry/geometries/point_xy.hpp>
-#include <boost/geometry/geometries/polygon.hpp>
 #include <nlohmann/json.hpp>
 
+#include "drover/topology/conflicts.hpp"
 #include "tests/launcher/launch_test_support.hpp"
 
 namespace drover::test {
 namespace {
 
 namespace bg = boost::geometry;
-using Point = bg::model::d2::point_xy<double>;
-using Polygon = bg::model::polygon<Point>;
+using topology::Point;
+using topology::Polygon;
 
 using namespace std::chrono_literals;
 
@@ -36,8 +35,6 @@ using namespace std::chrono_literals;
 /// do a load-and-unload order in about 60-120 simulated seconds each.
 constexpr const char* kDurationS = "600";
 constexpr const char* kTimeFactor = "8";
-/// Overlap of two footprints' interiors that counts (m^2); touching is no overlap.
-constexpr double kOverlapArea = 1e-6;
 
 struct Status {
   std::int64_t t = 0;
@@ -93,11 +90,8 @@ std::vector<std::string> overlaps(std::vector<Status> statuses) {
     latest[status.vehicle] = &status;
     for (const auto& [vehicle, other] : latest) {
       if (vehicle == status.vehicle) continue;
-      std::vector<Polygon> common;
-      bg::intersection(status.footprint, other->footprint, common);
-      double area = 0;
-      for (const auto& part : common) area += bg::area(part);
-      if (area > kOverlapArea && found.size() < 10) {
+      const double area = topology::footprint_overlap_area(status.footprint, other->footprint);
+      if (area > topology::kOverlapAreaEpsilon && found.size() < 10) {
         found.push_back(status.vehicle + " at t=" + std::to_string(status.t) + " overlaps " + vehicle +
                         " (its status of t=" + std::to_string(other->t) + ") by " + std::to_string(area) + " m2: " +
                         wkt(status.footprint) + " / " + wkt(other->footprint));

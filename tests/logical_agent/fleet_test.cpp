@@ -27,6 +27,8 @@
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
 #include "drover/ran_runner/client.hpp"
+#include "agents/topology_agent/topology_agent.hpp"
+#include "drover/topology/conflicts.hpp"
 #include "drover/topology/topology_file.hpp"
 #include "tests/agents/child_process.hpp"
 
@@ -87,7 +89,9 @@ class Fleet {
       child.signal(SIGTERM);
       const auto status = child.wait_exit(30s);
       EXPECT_TRUE(status.has_value()) << name << " did not stop on SIGTERM";
-      if (status) EXPECT_TRUE(status->exited && status->code == 0) << name << " ended with " << status->code;
+      if (status) {
+        EXPECT_TRUE(status->exited && status->code == 0) << name << " ended with " << status->code;
+      }
       if (::testing::Test::HasFailure()) std::cerr << "---- " << name << " ----\n" << read_file((dir_ / (name + ".log")).string());
       children_.pop_back();
     }
@@ -114,7 +118,8 @@ struct Observations {
   std::map<std::string, ran::VehicleStatus> latest;                 ///< vehicle -> status
   std::vector<std::string> overlaps;                                ///< footprints overlapping
   std::map<std::string, std::vector<std::pair<TimeNs, TimeNs>>> on_bar;  ///< vehicle -> times on bar-2
-  std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, holder)
+  std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, allocated to)
+  std::uint64_t last_serial = 0;                                    ///< of the last topology event
 
   bool wait(const std::function<bool()>& condition, std::chrono::seconds timeout) {
     std::unique_lock lock(mutex);
@@ -166,10 +171,14 @@ class FleetTest : public ::testing::Test {
         events);
     ASSERT_TRUE(alarms.has_value());
     alarms_ = std::move(*alarms);
-    auto timelines = dds::Reader<msg::TimelineState>::create(
-        *participant_, "drover/topology/timeline", [this](const msg::TimelineState& state) { on_timeline(state); });
-    ASSERT_TRUE(timelines.has_value());
-    timelines_ = std::move(*timelines);
+    // Holds are followed from the topology agent's events, which carry one serial order: the
+    // timelines are keyed per entity, and a reader may deliver two entities' updates in
+    // another order than they were made in.
+    auto topology_events = dds::Reader<msg::TopologyEvent>::create(
+        *participant_, topology_agent::kEventTopic, [this](const msg::TopologyEvent& event) { on_event(event); },
+        events);
+    ASSERT_TRUE(topology_events.has_value());
+    topology_events_ = std::move(*topology_events);
     for (const auto& vehicle : vehicles) {
       auto client = ran::RanClient::create(*participant_, vehicle, {}, 16,
                                            [this](const ran::VehicleStatus& status) { on_status(status); });
@@ -185,27 +194,36 @@ class FleetTest : public ::testing::Test {
   void TearDown() override {
     order_client_.reset();
     rans_.clear();
-    timelines_.reset();
+    topology_events_.reset();
     alarms_.reset();
     notices_.reset();
     progress_.reset();
     participant_.reset();
   }
 
-  void on_timeline(const msg::TimelineState& state) {
+  void on_event(const msg::TopologyEvent& event) {
     std::lock_guard lock(seen_.mutex);
-    seen_.holders[state.entity()] = state.holder();
-    seen_.holder_log[state.entity()].emplace_back(clock_->now(), state.holder());
-    if (state.holder().empty()) return;
-    const auto entity = world_->find(state.entity());
-    if (!entity) return;
-    for (const auto other : world_->conflicts(*entity)) {
-      const auto& holder = seen_.holders[world_->id(other)];
-      if (!holder.empty() && holder != state.holder()) {
-        seen_.hold_violations.push_back(state.holder() + " holds " + state.entity() + " while " + holder +
-                                        " holds " + world_->id(other));
+    if (event.serial() != seen_.last_serial + 1) {
+      seen_.hold_violations.push_back("topology event " + std::to_string(event.serial()) + " after " +
+                                      std::to_string(seen_.last_serial) + ": events lost or out of order");
+    }
+    seen_.last_serial = event.serial();
+    if (event.kind() == msg::EVENT_RELEASED) {
+      if (seen_.holders[event.entity()] == event.agent()) seen_.holders[event.entity()].clear();
+    } else if (event.kind() == msg::EVENT_ALLOCATED) {
+      seen_.holders[event.entity()] = event.agent();
+      seen_.holder_log[event.entity()].emplace_back(event.time(), event.agent());
+      const auto entity = world_->find(event.entity());
+      if (!entity) return;
+      for (const auto other : world_->conflicts(*entity)) {
+        const auto& holder = seen_.holders[world_->id(other)];
+        if (!holder.empty() && holder != event.agent()) {
+          seen_.hold_violations.push_back(event.agent() + " holds " + event.entity() + " while " + holder +
+                                          " holds " + world_->id(other));
+        }
       }
     }
+    seen_.changed.notify_all();
   }
 
   void on_status(const ran::VehicleStatus& status) {
@@ -213,10 +231,7 @@ class FleetTest : public ::testing::Test {
     seen_.latest[status.vehicle_id] = status;
     for (const auto& [other, other_status] : seen_.latest) {
       if (other == status.vehicle_id) continue;
-      std::vector<topology::Polygon> common;
-      bg::intersection(status.footprint, other_status.footprint, common);
-      double area = 0;
-      for (const auto& part : common) area += bg::area(part);
+      const double area = topology::footprint_overlap_area(status.footprint, other_status.footprint);
       if (area > 1e-6) {
         seen_.overlaps.push_back(status.vehicle_id + " and " + other + " overlap by " + std::to_string(area) + " m^2");
       }
@@ -274,7 +289,7 @@ class FleetTest : public ::testing::Test {
   std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_;
   std::unique_ptr<dds::Reader<msg::ReservationNotice>> notices_;
   std::unique_ptr<dds::Reader<msg::OperatorAlarm>> alarms_;
-  std::unique_ptr<dds::Reader<msg::TimelineState>> timelines_;
+  std::unique_ptr<dds::Reader<msg::TopologyEvent>> topology_events_;
   std::map<std::string, std::unique_ptr<ran::RanClient>> rans_;
   std::unique_ptr<dds::ServiceClient<msg::OrderRequest, msg::OrderReply>> order_client_;
 };
@@ -283,9 +298,10 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
   constexpr std::uint32_t kDomain = 186;
   Fleet fleet(kDomain, "crossing");
   fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   fleet.start_vehicle("V1", "left-0");
   fleet.start_vehicle("V2", "right-0");
-  watch(kDomain, fleet, {"V1", "V2"});
   ASSERT_TRUE(wait_ready("V1", "left-0"));
   ASSERT_TRUE(wait_ready("V2", "right-0"));
 
@@ -328,9 +344,10 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   constexpr std::uint32_t kDomain = 187;
   Fleet fleet(kDomain, "stall");
   fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   fleet.start_vehicle("V1", "left-0");
   fleet.start_vehicle("V2", "right-0");
-  watch(kDomain, fleet, {"V1", "V2"});
   ASSERT_TRUE(wait_ready("V1", "left-0"));
   ASSERT_TRUE(wait_ready("V2", "right-0"));
   ASSERT_EQ(send_order("V1", "v1-stall", {{"right-4", "NOP"}}), "");
@@ -386,8 +403,9 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
   constexpr std::uint32_t kDomain = 188;
   Fleet fleet(kDomain, "lock");
   fleet.start_infrastructure();
-  fleet.start_vehicle("V1", "left-0");
   watch(kDomain, fleet, {"V1"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  fleet.start_vehicle("V1", "left-0");
   ASSERT_TRUE(wait_ready("V1", "left-0"));
   ASSERT_EQ(send_order("V1", "v1-lock", {{"right-4", "NOP"}}), "");
   // Once V1 has its route (it moves), lock bar-3 ahead of it for 30 s.

@@ -29,16 +29,20 @@ double box_overlap_area(const Box& a, const Box& b) {
 
 }  // namespace
 
-bool footprints_overlap(const Polygon& a, const Polygon& b) {
+double footprint_overlap_area(const Polygon& a, const Polygon& b) {
   // The intersection of the bounding boxes bounds the intersection of the polygons: a cheap
   // rejection of pairs that merely touch, which is most pairs on a grid.
   if (box_overlap_area(bg::return_envelope<Box>(a), bg::return_envelope<Box>(b)) <=
       kOverlapAreaEpsilon) {
-    return false;
+    return 0.0;
   }
   bg::model::multi_polygon<Polygon> common;
   bg::intersection(a, b, common);
-  return bg::area(common) > kOverlapAreaEpsilon;
+  return bg::area(common);
+}
+
+bool footprints_overlap(const Polygon& a, const Polygon& b) {
+  return footprint_overlap_area(a, b) > kOverlapAreaEpsilon;
 }
 
 std::vector<std::vector<EntityIndex>> compute_conflict_sets(

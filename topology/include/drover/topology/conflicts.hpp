@@ -15,6 +15,10 @@ namespace drover::topology {
 /// rounding of generated footprints leaves a sliver of overlap far thinner than this.
 inline constexpr double kOverlapAreaEpsilon = 1e-6;
 
+/// The area (m^2) of the intersection of `a` and `b`; 0 when they are disjoint or only touch.
+/// \pre both are corrected, valid polygons.
+double footprint_overlap_area(const Polygon& a, const Polygon& b);
+
 /// True when the interiors of `a` and `b` overlap (intersection area > kOverlapAreaEpsilon).
 /// \pre both are corrected, valid polygons.
 bool footprints_overlap(const Polygon& a, const Polygon& b);
