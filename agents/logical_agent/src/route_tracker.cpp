@@ -44,7 +44,10 @@ ran::MoveCommand RouteTracker::command_move(std::size_t edge_step, const std::st
   move.target_vertex = world.id(target);
   move.target = ran::TargetPose{vertex.position.x(), vertex.position.y(), vertex.orientation};
   move.edge = world.id(steps_.at(edge_step).entity);
-  move.max_speed = std::min(max_speed, world.edge(steps_.at(edge_step).entity).max_speed);
+  // The edge's own limit and its restriction's, as the RAN checks them (ran/src/validation.cpp).
+  const auto& edge = world.edge(steps_.at(edge_step).entity);
+  move.max_speed = std::min(max_speed, edge.max_speed);
+  if (edge.restrictions.max_speed) move.max_speed = std::min(move.max_speed, *edge.restrictions.max_speed);
   for (std::size_t i = edge_step - 1; i <= edge_step + 1; ++i) {
     move.area.push_back(world.footprint(steps_.at(i).entity));
   }
