@@ -290,6 +290,14 @@ void TopologyAgent::on_abort(const msg::ReserveAbortRequest& request, StatusHand
   send_status(reply, aborted);
 }
 
+bool TopologyAgent::first_step_of_route(topology::EntityIndex entity, const std::string& agent) const {
+  const auto& reservations = timelines_.timeline(entity).reservations;
+  const auto mine = std::find_if(reservations.begin(), reservations.end(), [&](const topology::Reservation& r) {
+    return r.agent == agent && r.origin == entity && !r.prepared;
+  });
+  return mine != reservations.end() && mine->step == 0;
+}
+
 bool TopologyAgent::locked_now(topology::EntityIndex entity) const {
   const TimeNs now = clock_.now();
   const auto in_force = [&](topology::EntityIndex e) {
@@ -308,11 +316,12 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
   const bool held_before = timelines_.timeline(*entity).holder == request.agent();
-  // A lock in force now on the entity or its conflict set keeps everyone off it (I4),
-  // whatever the reservation order says: a vehicle running early on a route planned around
-  // the lock must not be let on. Not queued: the requester asks again (no grant comes when
-  // a lock ends).
-  if (!held_before && locked_now(*entity)) {
+  // A lock in force now on the entity or its conflict set keeps vehicles from driving onto
+  // it (I4), whatever the reservation order says: a vehicle running early on a route planned
+  // around the lock must not be let on. Except the first step of a route: that is where the
+  // vehicle stands, and it must be able to hold it again whenever it re-plans. Not queued:
+  // the requester asks again (no grant comes when a lock ends).
+  if (!held_before && !first_step_of_route(*entity, request.agent()) && locked_now(*entity)) {
     msg::AllocateReply out;
     out.granted(false);
     out.queue_position(0);

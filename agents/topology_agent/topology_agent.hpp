@@ -116,6 +116,9 @@ class TopologyAgent {
   /// Whether a lock on `entity` or a member of its conflict set is in force now. Requires
   /// mutex_ held.
   bool locked_now(topology::EntityIndex entity) const;
+  /// Whether `agent`'s first committed real reservation on `entity` is step 0 of its route
+  /// (where the vehicle stands when it planned). Requires mutex_ held.
+  bool first_step_of_route(topology::EntityIndex entity, const std::string& agent) const;
   Status after_change(const std::vector<topology::Grant>& grants, std::vector<msg::TopologyEvent> events = {},
                       bool notify_grants = true);
   void notify(msg::ReservationNotice notice);

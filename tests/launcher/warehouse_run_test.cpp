@@ -33,7 +33,7 @@ using namespace std::chrono_literals;
 
 /// Simulated seconds the run lasts and how much faster than real time it runs: 8 vehicles
 /// do a load-and-unload order in about 60-120 simulated seconds each.
-constexpr const char* kDurationS = "600";
+constexpr const char* kDurationS = "900";
 constexpr const char* kTimeFactor = "8";
 
 struct Status {

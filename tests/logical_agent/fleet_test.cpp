@@ -351,6 +351,14 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   ASSERT_TRUE(wait_ready("V1", "left-0"));
   ASSERT_TRUE(wait_ready("V2", "right-0"));
   ASSERT_EQ(send_order("V1", "v1-stall", {{"right-4", "NOP"}}), "");
+  // V2's order only once V1 drives (its route is reserved): V1 is then first on the bar.
+  ASSERT_TRUE(seen_.wait(
+      [&] {
+        auto found = seen_.latest.find("V1");
+        return found != seen_.latest.end() && found->second.pose.y > 0.1;
+      },
+      120s))
+      << "V1 never started";
   ASSERT_EQ(send_order("V2", "v2-stall", {{"left-4", "NOP"}}), "");
 
   // Stall V1 as soon as it drives on the bar (ahead of V2, which waits for it).

@@ -431,7 +431,7 @@ TEST_F(RoutingAgentTest, ConcurrentRealRoutesThroughTwoRoutingAgentsNeverDoubleB
   // Every committed route shows on the timelines with one real reservation per step and as
   // many shadows as its steps' conflict sets have members (the two partitions publish
   // independently, so one may show a route a moment before the other).
-  ASSERT_TRUE(wait_until([&] {
+  EXPECT_TRUE(wait_until([&] {
     std::map<std::pair<std::string, std::uint64_t>, std::size_t> real_steps, shadows, expected_shadows;
     for (const auto& [entity, state] : timelines_) {
       for (const auto& item : state.reservations()) {
@@ -446,7 +446,7 @@ TEST_F(RoutingAgentTest, ConcurrentRealRoutesThroughTwoRoutingAgentsNeverDoubleB
     }
     std::erase_if(expected_shadows, [](const auto& entry) { return entry.second == 0; });
     return real_steps == committed && shadows == expected_shadows;
-  })) << "the published timelines never showed exactly the committed routes with their shadows";
+  })) << "the published timelines never showed exactly the committed routes with their shadows (details below)";
 
   // I1 on every timeline (shadows carry conflict sets), and every real reservation has its
   // shadows on its whole conflict set.
@@ -519,6 +519,7 @@ TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire
 
   // The same windows are free again: another routing agent reserves them for v2.
   start_routing_agent(kDomain, "routing-2");
+  ASSERT_TRUE(client_->wait_for_server(kTimeout, "routing-2").has_value());
   auto reply = call(route_request("v2", "a", "d", true, start), "routing-2");
   ASSERT_EQ(reply.error().code(), msg::ERROR_NONE) << reply.error().message();
   EXPECT_EQ(reply.steps().front().window().start(), start);

@@ -21,6 +21,8 @@ namespace {
 
 /// Pause (real time) between two route attempts the timelines or a missing agent refused.
 constexpr std::chrono::milliseconds kRoutePause{500};
+/// How long stop_vehicle waits for the vehicle to report standing still after a cancel.
+constexpr std::chrono::seconds kStopWait{10};
 /// A RAN silent for this long (real time) counts as a recoverable error ("ran_lost").
 constexpr std::chrono::seconds kRanSilence{3};
 /// After a failed attempt to reach a charger, the next one waits this long (shared clock).
@@ -90,7 +92,9 @@ void LogicalAgent::run() {
     publish_vehicle_state(false);
     wait_event();
   }
-  // Clean shutdown: future reservations go; what the vehicle occupies stays allocated.
+  // Clean shutdown: the vehicle stops (it must not drive on into what is given up), future
+  // reservations go; what the vehicle occupies stays allocated.
+  stop_vehicle();
   if (route_) {
     if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id()); !cancelled) {
       spdlog::warn("route {} not cancelled on shutdown: {}", route_->id(), cancelled.error().message);
@@ -140,6 +144,22 @@ bool LogicalAgent::hold_position() {
   }
   position_alarm_raised_ = false;
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
+  return true;
+}
+
+bool LogicalAgent::drivable(const std::vector<topology::RouteStep>& steps) const {
+  if (steps.size() % 2 == 0) return false;
+  for (std::size_t i = 0; i < steps.size(); i += 2) {
+    if (!topology_->is_vertex(steps[i].entity)) return false;
+    if (i == 0) continue;
+    const auto edge = steps[i - 1].entity;
+    if (!topology_->is_edge(edge)) return false;
+    const auto moves = topology_->moves_from(steps[i - 2].entity);
+    const bool leads = std::any_of(moves.begin(), moves.end(), [&](const topology::Move& move) {
+      return move.edge == edge && move.to == steps[i].entity;
+    });
+    if (!leads) return false;
+  }
   return true;
 }
 
@@ -196,10 +216,12 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
         }
         steps.push_back(topology::RouteStep{*entity, {step.window().start(), step.window().end()}});
       }
-      if (steps.empty() || steps.front().entity != *vertex_ || steps.back().entity != goal) {
+      if (steps.empty() || steps.front().entity != *vertex_ || steps.back().entity != goal ||
+          !drivable(steps)) {
         cancel_route_quietly(reply->route());
         return fail(ErrorCode::internal, "the routing agent answered a route that does not lead from '" +
-                                             topology_->id(*vertex_) + "' to '" + topology_->id(goal) + "'");
+                                             topology_->id(*vertex_) + "' to '" + topology_->id(goal) +
+                                             "' as vertex, edge, vertex, ... along drivable edges");
       }
       spdlog::info("route {} to '{}': {} steps, {:.1f} m, arrival in {}", reply->route(), topology_->id(goal),
                    steps.size(), reply->distance(), seconds_text(reply->arrival() - clock_.now()));
@@ -237,6 +259,10 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     auto outcome = services_->allocate(vehicle_id(), here, options_.allocate_wait);
     if (!outcome) return unexpected(outcome.error());
     if (outcome->granted) break;
+    // Not granted at once (its owner restarting, say): ask again after a tick, not in a
+    // busy loop.
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, options_.tick, [&] { return stopping_.load(); });
   }
   if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
   monitor_.forget_steps();
@@ -354,6 +380,8 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
                                           verdict->code, verdict->reason)
                             : "the RAN did not take the move to '" + move.target_vertex + "': " + verdict.error().message;
           raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+          // Unanswered, the RAN may still have taken the move: cancel it with the others.
+          if (!verdict) pending_moves_.emplace_back(move.id, *edge + 1);
           stop_vehicle();
           return FollowResult::failed;
         }
@@ -492,10 +520,19 @@ void LogicalAgent::process_notices(bool& replan) {
 
 void LogicalAgent::stop_vehicle() {
   if (pending_moves_.empty()) return;
+  const TimeNs asked = clock_.now();
   if (auto cancelled = ran_->cancel(pending_moves_.front().first, options_.call_timeout); !cancelled) {
     spdlog::warn("cancel of the moves not delivered: {}", cancelled.error().message);
   }
   pending_moves_.clear();
+  // A cancelled vehicle brakes into what it was allowed onto: nothing may be released
+  // before it stands, so wait (bounded) for a status after the cancel that shows it still.
+  std::unique_lock lock(mutex_);
+  const bool standing = wake_.wait_for(lock, kStopWait, [&] {
+    return status_ && status_->time > asked && std::abs(status_->linear_speed) < 1e-3 &&
+           std::abs(status_->angular_speed) < 1e-3;
+  });
+  if (!standing) spdlog::warn("vehicle '{}' did not report standing still after the cancel", vehicle_id());
 }
 
 void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
@@ -506,8 +543,8 @@ void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
 
 void LogicalAgent::abandon_route() {
   if (!route_) return;
+  stop_vehicle();  // before anything is released
   cancel_route_quietly(route_->id());
-  pending_moves_.clear();
   monitor_.forget_steps();
   if (const auto status = latest_status()) {
     for (const auto entity : monitor_.releasable(status->footprint, 0)) {

@@ -116,6 +116,9 @@ class LogicalAgent {
   /// \param patience  how long (shared clock) to keep trying while the timelines or locks
   ///                  leave no route; 0: one try.
   Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience);
+  /// Whether `steps` alternate vertex, edge, vertex, ... with each edge drivable from the
+  /// vertex before it to the vertex after it (what RouteTracker relies on).
+  bool drivable(const std::vector<topology::RouteStep>& steps) const;
   /// Makes `next` the current route: swaps the vertex the vehicle holds onto it, cancels
   /// the previous route.
   Status switch_route(RouteTracker next);
