@@ -121,6 +121,16 @@ TEST(LaunchFile, UnknownKindAndFieldsAreNamed) {
   EXPECT_NE(text.find("agents[2].max_restarts: must be an integer in 0..1000"), std::string::npos) << text;
 }
 
+// Values the logical agent would refuse are refused here, so that nothing is started.
+TEST(LaunchFile, LogicalAgentFieldsOutOfRange) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
+      {"kind": "logical", "vehicle": "V1", "lookahead": 0, "charge_below": 1.5, "charge_to": -0.1})"));
+  EXPECT_NE(text.find("agents[3].lookahead: must be an integer >= 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].charge_below: must be a number from 0 to 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].charge_to: must be a number from 0 to 1"), std::string::npos) << text;
+}
+
 TEST(LaunchFile, VerticesPartitionsAndProfilesMustExist) {
   const auto text = problems_of(loop_file(R"({"kind": "topology", "partition": "north"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "nowhere", "profile": "fast"},

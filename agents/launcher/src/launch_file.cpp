@@ -27,6 +27,8 @@ enum class FieldType {
   number,           ///< a finite number
   positive_number,  ///< a finite number > 0
   count,            ///< an integer >= 0
+  positive_count,   ///< an integer >= 1
+  fraction,         ///< a number in [0, 1]
   flag,             ///< true adds the option without a value; false leaves it out
   journal,          ///< a file path; relative ones are relative to the state directory
 };
@@ -85,11 +87,11 @@ const std::vector<KindRules>& kind_rules() {
       {AgentKind::routing, "routing", "routing-agent", "--id", "", false, false,
        {{"log_level", "--log-level", FieldType::text}}},
       {AgentKind::logical, "logical", "logical-agent", "--id", "", true, true,
-       {{"lookahead", "--lookahead", FieldType::count},
+       {{"lookahead", "--lookahead", FieldType::positive_count},
         {"delay_threshold", "--delay-threshold", FieldType::positive_number},
         {"park_after", "--park-after", FieldType::number},
-        {"charge_below", "--charge-below", FieldType::number},
-        {"charge_to", "--charge-to", FieldType::number},
+        {"charge_below", "--charge-below", FieldType::fraction},
+        {"charge_to", "--charge-to", FieldType::fraction},
         {"error_limit", "--error-limit", FieldType::positive_number},
         {"route_limit", "--route-limit", FieldType::number},
         {"log_level", "--log-level", FieldType::text}}},
@@ -443,12 +445,21 @@ class LaunchFileParser {
         }
         options.insert(options.end(), {option, format_number(value.get<double>())});
         return;
+      case FieldType::fraction:
+        if (!value.is_number() || !(value.get<double>() >= 0.0 && value.get<double>() <= 1.0)) {
+          return checker_.problem(where, "must be a number from 0 to 1");
+        }
+        options.insert(options.end(), {option, format_number(value.get<double>())});
+        return;
       case FieldType::count:
-        if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
-          return checker_.problem(where, "must be an integer >= 0");
+      case FieldType::positive_count: {
+        const std::int64_t least = rule.type == FieldType::count ? 0 : 1;
+        if (!value.is_number_integer() || value.get<std::int64_t>() < least) {
+          return checker_.problem(where, "must be an integer >= " + std::to_string(least));
         }
         options.insert(options.end(), {option, std::to_string(value.get<std::int64_t>())});
         return;
+      }
       case FieldType::flag:
         if (!value.is_boolean()) return checker_.problem(where, "must be true or false");
         if (value.get<bool>()) options.push_back(option);

@@ -130,6 +130,13 @@ LogicalAgent::~LogicalAgent() {
 }
 
 void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply) {
+  if (request.header().responder().empty()) {
+    // Every logical agent sees an unaddressed request: taking it would queue it many times.
+    const Error refused{ErrorCode::invalid_argument,
+                        "order '" + request.order() + "': header.responder must name the vehicle it is for"};
+    if (auto sent = reply.send_error(refused); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+    return;
+  }
   msg::OrderReply answer;
   OrderSpec spec;
   spec.name = request.order();
