@@ -32,14 +32,16 @@ std::optional<MissingEntity> KnownEntities::first_missing(const std::string& sta
     return std::nullopt;
   }
 
-  // Breadth-first over the drivable component; `seen` holds every id already checked.
-  std::set<std::string> seen{start};
+  // Breadth-first over the drivable component; `traversed` holds every entity queued. An
+  // entity first met as a conflict member is only checked, and still traversed when it is
+  // reached by driving later (its own conflicts must then be complete too).
+  std::set<std::string> traversed{start};
   std::deque<const msg::EntityDescription*> queue{find(start)};
   auto need = [&](const std::string& id, const std::string& by,
                   bool traverse) -> std::optional<MissingEntity> {
     const auto* description = find(id);
     if (description == nullptr) return MissingEntity{id, by};
-    if (seen.insert(id).second && traverse) queue.push_back(description);
+    if (traverse && traversed.insert(id).second) queue.push_back(description);
     return std::nullopt;
   };
   while (!queue.empty()) {

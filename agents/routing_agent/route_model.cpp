@@ -93,6 +93,8 @@ Result<std::unique_ptr<RouteModel>> RouteModel::build(const KnownEntities& known
   std::vector<std::vector<topology::EntityIndex>> conflict_sets(topology->entity_count());
   for (topology::EntityIndex entity = 0; entity < topology->entity_count(); ++entity) {
     for (const auto& other : known.find(topology->id(entity))->conflicts()) {
+      // Unknown members only occur outside the components KnownEntities::first_missing
+      // found complete, which no plan on this model reaches.
       if (auto index = topology->find(other)) conflict_sets[entity].push_back(*index);
     }
     std::sort(conflict_sets[entity].begin(), conflict_sets[entity].end());

@@ -153,8 +153,9 @@ class RoutingAgentTest : public ::testing::Test {
     start(id, args);
   }
 
-  /// The test's participant, a route client and a reader of every published timeline.
-  void connect(std::uint32_t domain) {
+  /// The test's participant, a route client and a reader of every published timeline;
+  /// waits until that reader has matched `timeline_writers` topology agents.
+  void connect(std::uint32_t domain, std::size_t timeline_writers = 0) {
     dds::ParticipantOptions options;
     options.domain_id = domain;
     options.agent_id = "tester";
@@ -171,6 +172,7 @@ class RoutingAgentTest : public ::testing::Test {
           changed_.notify_all();
         });
     ASSERT_TRUE(timelines.has_value());
+    ASSERT_TRUE((*timelines)->wait_for_writers(timeline_writers, kTimeout)) << "the topology agents never matched";
     readers_.push_back(std::shared_ptr<void>(std::move(*timelines)));
   }
 
@@ -493,8 +495,12 @@ TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire
   constexpr std::uint32_t kDomain = 153;
   use_line_topology();
   start_topology_agents(kDomain, topology_file_);
-  start_routing_agent(kDomain, "routing-held", {"--hold-after-prepare", "--prepare-ttl", "2"});
-  connect(kDomain);
+  start_routing_agent(kDomain, "routing-held", {"--hold-after-prepare", "--prepare-ttl", "4"});
+  start_routing_agent(kDomain, "routing-2");
+  // The holds live 4 s: the test must see the timelines live by then, so it waits for the
+  // topology agents' writers (transient-local alone would only show the state after expiry).
+  connect(kDomain, 2);
+  ASSERT_TRUE(client_->wait_for_server(kTimeout, "routing-held").has_value());
 
   const TimeNs start = SharedClock::wall().now() + seconds_to_ns(60);
   // The call never gets an answer: the agent holds, then dies.
@@ -518,9 +524,17 @@ TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire
       << "the held reservations of the killed routing agent never expired";
 
   // The same windows are free again: another routing agent reserves them for v2.
-  start_routing_agent(kDomain, "routing-2");
   ASSERT_TRUE(client_->wait_for_server(kTimeout, "routing-2").has_value());
-  auto reply = call(route_request("v2", "a", "d", true, start), "routing-2");
+  // Its replica follows the topology agents' timelines a moment later: ask until it has
+  // taken in the expiry.
+  msg::RouteReply reply;
+  const auto deadline = std::chrono::steady_clock::now() + kTimeout;
+  do {
+    reply = call(route_request("v2", "a", "d", true, start), "routing-2");
+    if (reply.error().code() == msg::ERROR_NONE) break;
+    std::unique_lock lock(mutex_);
+    changed_.wait_for(lock, 100ms);
+  } while (std::chrono::steady_clock::now() < deadline);
   ASSERT_EQ(reply.error().code(), msg::ERROR_NONE) << reply.error().message();
   EXPECT_EQ(reply.steps().front().window().start(), start);
   EXPECT_EQ(reply.arrival(), start + seconds_to_ns(9)) << "v2 drove straight through, nothing in its way";
