@@ -32,8 +32,9 @@ using topology::Polygon;
 using namespace std::chrono_literals;
 
 /// Simulated seconds the run lasts and how much faster than real time it runs: 8 vehicles
-/// do a load-and-unload order in about 60-120 simulated seconds each.
-constexpr const char* kDurationS = "900";
+/// do a load-and-unload order in about 60-180 simulated seconds each, with waits for one
+/// another; 1500 s leaves a wide margin over the 20 orders the test asks for.
+constexpr const char* kDurationS = "1500";
 constexpr const char* kTimeFactor = "8";
 
 struct Status {
