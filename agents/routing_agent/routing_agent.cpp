@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "agents/routing_agent/route_wire.hpp"
+#include "agents/topology_agent/wire.hpp"
 #include "drover/dds/shutdown_signal.hpp"
 #include "drover/dds/wire_error.hpp"
 
@@ -268,16 +269,8 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
           shares.back().request.agent(plan.agent);
           shares.back().request.route(route_id);
         }
-        msg::Reservation wire;
-        wire.agent(item.agent);
-        wire.route(item.route);
-        wire.step(item.step);
-        wire.entity(topology.id(item.entity));
-        wire.origin(topology.id(item.origin));
-        wire.window().start(item.window.start);
-        wire.window().end(item.window.end);
         auto& share = shares[it->second];
-        share.request.items().push_back(std::move(wire));
+        share.request.items().push_back(topology_agent::to_wire(topology, item));
         if (touched.insert(item.entity).second) {
           msg::EntityVersion version;
           version.entity(topology.id(item.entity));
