@@ -217,10 +217,15 @@ Result<std::string> RoutingAgent::owner_of(const std::string& partition) const {
 Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const msg::RouteRequest& request,
                                                                            carp::PlanRequest plan) {
   topology::RouteId route_id = request.route();
-  if (route_id == 0) {
+  // Without a route id from the client, each attempt takes a new one: a hold of an earlier
+  // attempt whose abort was lost (a call that timed out) must not make the next attempt's
+  // prepare of the same steps fail; it expires by itself.
+  const auto fresh_route_id = [this] {
     std::lock_guard lock(mutex_);
-    while (route_id == 0) route_id = route_ids_();
-  }
+    topology::RouteId id = 0;
+    while (id == 0) id = route_ids_();
+    return id;
+  };
   auto abort_all = [this](std::vector<PartitionShare>& shares) {
     for (auto& share : shares) {
       if (share.prepare_id == 0) continue;
@@ -237,6 +242,7 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
 
   Error last_conflict{ErrorCode::conflict, "no attempt made"};
   for (int attempt = 1; attempt <= options_.max_attempts; ++attempt) {
+    if (request.route() == 0) route_id = fresh_route_id();
     // Plan on the replica and split the reservations by owning partition.
     std::vector<PartitionShare> shares;
     std::map<topology::EntityIndex, std::uint64_t> planned_versions;
