@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake git pkg-config
+  build-essential cmake git pkg-config ccache
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libeigen3-dev libboost-dev
   nlohmann-json3-dev libspdlog-dev libfmt-dev libcli11-dev

@@ -6,12 +6,14 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <list>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include <boost/geometry.hpp>
+#include <nlohmann/json.hpp>
 #include <gtest/gtest.h>
 
 #include "drover/dds/participant.hpp"
@@ -26,7 +29,9 @@
 #include "drover/dds/service_client.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
+#include "drover/ran/sim_driver.hpp"
 #include "drover/ran_runner/client.hpp"
+#include "drover/ran_runner/runner.hpp"
 #include "agents/topology_agent/topology_agent.hpp"
 #include "drover/topology/conflicts.hpp"
 #include "drover/topology/topology_file.hpp"
@@ -64,46 +69,123 @@ class Fleet {
   SharedClock clock() const { return *SharedClock::create_at_origin(origin_, kTimeFactor, origin_); }
   const std::string& topology_file() const { return topology_file_; }
 
-  void start(const std::string& name, std::vector<std::string> args) {
-    args.insert(args.end(), {"--domain", std::to_string(domain_), "--time-factor", std::to_string(kTimeFactor),
+  /// Uses `file` instead of the bundled H crossing (call before starting anything).
+  void use_topology(std::string file) { topology_file_ = std::move(file); }
+  const std::filesystem::path& dir() const { return dir_; }
+
+  /// Starts `drover ARGS` on the fleet's domain and clock, logging to NAME.log.
+  void start(const std::string& name, const std::vector<std::string>& args) {
+    auto full = args;
+    full.insert(full.end(), {"--domain", std::to_string(domain_), "--time-factor", std::to_string(kTimeFactor),
                              "--epoch", std::to_string(origin_), "--clock-origin", std::to_string(origin_)});
     const auto log = (dir_ / (name + ".log")).string();
-    auto child = ChildProcess::spawn(binary_path("drover"), args, log, log);
+    // Appended, so that a restarted agent's log follows its first life's.
+    std::ofstream(log, std::ios::app) << "==== " << name << " started\n";
+    auto child = ChildProcess::spawn(binary_path("drover"), full, log, log);
     ASSERT_TRUE(child.has_value()) << name;
-    children_.emplace_back(name, std::move(*child));
+    children_.push_back(Child{name, args, std::move(*child)});
   }
-  void start_infrastructure() {
-    start("topology", {"topology-agent", "--topology", topology_file_});
+  void start_infrastructure(const std::string& journal = {}) {
+    std::vector<std::string> topology{"topology-agent", "--topology", topology_file_};
+    if (!journal.empty()) topology.insert(topology.end(), {"--db", (dir_ / journal).string()});
+    start("topology", topology);
     start("routing", {"routing-agent"});
   }
-  void start_vehicle(const std::string& id, const std::string& at) {
-    start("ran-" + id, {"ran-sim", "--id", id, "--topology", topology_file_, "--at", at, "--max-speed", "1",
-                        "--acceleration", "0.5", "--deceleration", "0.5"});
-    start(id, {"logical-agent", "--id", id, "--topology", topology_file_, "--vehicle", vehicle_file_,
-               "--park-after", "-1", "--charge-below", "0"});
+  /// A simulated RAN (extra options `ran`) and the logical agent (options `logical`, which
+  /// default to neither parking nor charging).
+  void start_vehicle(const std::string& id, const std::string& at, std::vector<std::string> ran = {},
+                     std::vector<std::string> logical = {"--park-after", "-1", "--charge-below", "0"}) {
+    start_ran(id, at, std::move(ran));
+    start_logical(id, std::move(logical));
+  }
+  void start_ran(const std::string& id, const std::string& at, std::vector<std::string> options = {}) {
+    std::vector<std::string> args{"ran-sim", "--id", id, "--topology", topology_file_, "--at", at, "--max-speed", "1",
+                                  "--acceleration", "0.5", "--deceleration", "0.5"};
+    args.insert(args.end(), options.begin(), options.end());
+    start("ran-" + id, args);
+  }
+  void start_logical(const std::string& id, std::vector<std::string> options) {
+    std::vector<std::string> args{"logical-agent", "--id", id, "--topology", topology_file_, "--vehicle", vehicle_file_};
+    args.insert(args.end(), options.begin(), options.end());
+    start(id, args);
+  }
+  /// SIGKILL to the agent started as `name` (a crash), then the same agent again.
+  void crash_and_restart(const std::string& name) {
+    auto found = std::find_if(children_.begin(), children_.end(), [&](const Child& c) { return c.name == name; });
+    ASSERT_NE(found, children_.end()) << name;
+    found->process.signal(SIGKILL);
+    ASSERT_TRUE(found->process.wait_exit(30s).has_value()) << name << " survived SIGKILL";
+    const auto args = found->args;
+    children_.erase(found);
+    start(name, args);
   }
   /// SIGTERM to everyone, newest first; each must exit 0.
   void stop() {
     while (!children_.empty()) {
-      auto& [name, child] = children_.back();
-      child.signal(SIGTERM);
-      const auto status = child.wait_exit(30s);
-      EXPECT_TRUE(status.has_value()) << name << " did not stop on SIGTERM";
+      auto& child = children_.back();
+      child.process.signal(SIGTERM);
+      const auto status = child.process.wait_exit(30s);
+      EXPECT_TRUE(status.has_value()) << child.name << " did not stop on SIGTERM";
       if (status) {
-        EXPECT_TRUE(status->exited && status->code == 0) << name << " ended with " << status->code;
+        EXPECT_TRUE(status->exited && status->code == 0) << child.name << " ended with " << status->code;
       }
-      if (::testing::Test::HasFailure()) std::cerr << "---- " << name << " ----\n" << read_file((dir_ / (name + ".log")).string());
+      if (::testing::Test::HasFailure()) {
+        std::cerr << "---- " << child.name << " ----\n" << read_file((dir_ / (child.name + ".log")).string());
+      }
       children_.pop_back();
     }
   }
 
  private:
+  struct Child {
+    std::string name;
+    std::vector<std::string> args;
+    ChildProcess process;
+  };
   std::uint32_t domain_;
   std::filesystem::path dir_;
   std::string topology_file_;
   std::string vehicle_file_;
   TimeNs origin_ = 0;
-  std::vector<std::pair<std::string, ChildProcess>> children_;
+  std::list<Child> children_;  // a list: ChildProcess cannot be move-assigned
+};
+
+/// A RAN whose vehicle drifts sideways once told to (a slipping wheel, a localisation
+/// error): the simulated vehicle, with an offset added to every pose and footprint it
+/// reports. What the logical agent must catch with its footprint monitoring.
+class DriftingDriver final : public ran::VehicleDriver {
+ public:
+  explicit DriftingDriver(ran::SimVehicle vehicle) : sim_(std::move(vehicle)) {}
+
+  void start(ran::StatusSink& sink, TimeNs now) override {
+    drifted_.target = &sink;
+    sim_.start(drifted_, now);
+  }
+  void stop(TimeNs now) override { sim_.stop(now); }
+  void on_move(const ran::MoveCommand& command, TimeNs now) override { sim_.on_move(command, now); }
+  void on_action(const ran::ActionCommand& command, TimeNs now) override { sim_.on_action(command, now); }
+  void on_cancel(const ran::CommandId& command, TimeNs now) override { sim_.on_cancel(command, now); }
+  void on_pause(TimeNs now) override { sim_.on_pause(now); }
+  void on_resume(TimeNs now) override { sim_.on_resume(now); }
+  void on_tick(TimeNs now) override { sim_.on_tick(now); }
+  /// From now on, every report is `dx` metres further along x. Call through
+  /// RanRunner::with_driver (never concurrently with the calls above).
+  void drift(double dx) { drifted_.dx = dx; }
+
+ private:
+  struct OffsetSink final : ran::StatusSink {
+    ran::StatusSink* target = nullptr;
+    double dx = 0;
+    void deliver(const ran::VehicleStatus& status) override {
+      ran::VehicleStatus moved = status;
+      moved.pose.x += dx;
+      moved.footprint.clear();
+      bg::transform(status.footprint, moved.footprint, bg::strategy::transform::translate_transformer<double, 2, 2>(dx, 0));
+      target->report(std::move(moved));
+    }
+  };
+  ran::SimDriver sim_;
+  OffsetSink drifted_;
 };
 
 /// Everything the test observes, in arrival order, with the shared-clock time of arrival.
@@ -203,7 +285,9 @@ class FleetTest : public ::testing::Test {
 
   void on_event(const msg::TopologyEvent& event) {
     std::lock_guard lock(seen_.mutex);
-    if (event.serial() != seen_.last_serial + 1) {
+    // A restarted topology agent counts its events anew from 1.
+    const bool restarted = event.serial() == 1 && seen_.last_serial != 0;
+    if (!restarted && event.serial() != seen_.last_serial + 1) {
       seen_.hold_violations.push_back("topology event " + std::to_string(event.serial()) + " after " +
                                       std::to_string(seen_.last_serial) + ": events lost or out of order");
     }
@@ -275,6 +359,17 @@ class FleetTest : public ::testing::Test {
         },
         std::chrono::duration_cast<std::chrono::seconds>(kRunTimeout));
     return out;
+  }
+
+  /// Waits until a status of `vehicle` satisfies `condition`.
+  bool wait_status(const std::string& vehicle, const std::function<bool(const ran::VehicleStatus&)>& condition,
+                   std::chrono::seconds timeout = 120s) {
+    return seen_.wait(
+        [&] {
+          auto found = seen_.latest.find(vehicle);
+          return found != seen_.latest.end() && condition(found->second);
+        },
+        timeout);
   }
 
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
@@ -456,6 +551,141 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
   }
   EXPECT_TRUE(held_after);
   EXPECT_EQ(seen_.holders["right-4"], "V1");
+}
+
+TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
+  constexpr std::uint32_t kDomain = 189;
+  Fleet fleet(kDomain, "restart");
+  fleet.start_infrastructure("topology.db");
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  fleet.start_vehicle("V1", "left-0");
+  fleet.start_vehicle("V2", "right-0");
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_EQ(send_order("V1", "v1-there", {{"right-4", "NOP"}}), "");
+  ASSERT_EQ(send_order("V2", "v2-there", {{"left-4", "NOP"}}), "");
+  // Both drive (their routes are reserved and allocated in part): the topology agent
+  // crashes and comes back from its journal, then the routing agent crashes and comes back.
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  fleet.crash_and_restart("topology");
+  ASSERT_TRUE(wait_status("V2", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V2 never started";
+  fleet.crash_and_restart("routing");
+
+  const auto first = wait_order("v1-there");
+  const auto second = wait_order("v2-there");
+  ASSERT_TRUE(first && second) << "an order did not end";
+  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
+  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
+  // New orders need new routes from the restarted routing agent and topology agent.
+  ASSERT_EQ(send_order("V1", "v1-back", {{"left-0", "NOP"}}), "");
+  const auto back = wait_order("v1-back");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
+TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
+  constexpr std::uint32_t kDomain = 190;
+  Fleet fleet(kDomain, "drift");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  // V1's RAN runs in this process, so that the test can make its vehicle drift.
+  ran::SimVehicleConfig config;
+  config.vehicle_id = "V1";
+  config.max_speed = 1;
+  config.acceleration = 0.5;
+  config.deceleration = 0.5;
+  const auto& start = world_->vertex(*world_->find("left-0")).position;
+  auto vehicle = ran::SimVehicle::create(config, ran::Pose{start.x(), start.y(), 0}, clock_->now(), world_);
+  ASSERT_TRUE(vehicle.has_value()) << vehicle.error().message;
+  DriftingDriver driver(std::move(*vehicle));
+  ran::RanNodeOptions options;
+  options.vehicle_id = "V1";
+  options.domain_id = kDomain;
+  auto node = ran::RanNode::create(driver, options, *clock_);
+  ASSERT_TRUE(node.has_value()) << node.error().message;
+  fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "v1-drift", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  (*node)->runner().with_driver([&](TimeNs) { driver.drift(1.5); });
+
+  const auto done = wait_order("v1-drift");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FAILED);
+  EXPECT_NE(done->failure().find("left its allocated area"), std::string::npos) << done->failure();
+  // The vehicle is stopped: it comes to stand and stays there.
+  EXPECT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed == 0.0; }, 60s));
+  std::lock_guard lock(seen_.mutex);
+  bool critical = false;
+  for (const auto& alarm : seen_.alarms) {
+    critical = critical || (alarm.severity() == msg::ALARM_CRITICAL && alarm.vehicle() == "V1" &&
+                            alarm.text().find("left its allocated area") != std::string::npos);
+  }
+  EXPECT_TRUE(critical) << "no critical alarm about the footprint";
+  EXPECT_TRUE(seen_.latest["V1"].pose.y < 6.0) << "V1 drove on to the bar after leaving its area";
+  // Stopping the logical agent before the in-process RAN goes away.
+  fleet.stop();
+}
+
+TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
+  constexpr std::uint32_t kDomain = 191;
+  Fleet fleet(kDomain, "park");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  // V2 stands on left-0, the parking vertex nearest to V1: V1 must take the other one.
+  fleet.start_vehicle("V2", "left-0");
+  ASSERT_TRUE(wait_ready("V2", "left-0"));
+  fleet.start_vehicle("V1", "left-4", {}, {"--park-after", "5", "--charge-below", "0"});
+  ASSERT_TRUE(wait_ready("V1", "left-4"));
+  ASSERT_TRUE(seen_.wait([&] { return seen_.holders["right-0"] == "V1"; }, 120s)) << "V1 never reached right-0";
+  EXPECT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) {
+    return std::abs(s.pose.x - 10.0) < 0.05 && std::abs(s.pose.y) < 0.05 && s.linear_speed == 0.0;
+  })) << "V1 does not stand on right-0";
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_EQ(seen_.holders["left-0"], "V2");
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
+}
+
+TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
+  constexpr std::uint32_t kDomain = 192;
+  Fleet fleet(kDomain, "charge");
+  // The H crossing with a charger at right-0.
+  auto json = nlohmann::json::parse(std::ifstream(source_dir() + "/launch/topologies/h_crossing.json"));
+  for (auto& vertex : json["vertices"]) {
+    if (vertex["id"] == "right-0") vertex["kind"] = "charger";
+  }
+  const auto file = (fleet.dir() / "h_charger.json").string();
+  std::ofstream(file) << json.dump(2);
+  fleet.use_topology(file);
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  // 15 Wh of 100: under the 20 % threshold; charging takes it to 45 % (1 Wh/s).
+  fleet.start_vehicle("V1", "left-4", {"--battery-capacity", "100", "--battery", "15"},
+                      {"--park-after", "-1", "--charge-below", "0.2", "--charge-to", "0.45"});
+  ASSERT_TRUE(seen_.wait([&] { return !seen_.holder_log["left-4"].empty(); }, 60s)) << "V1 never got ready";
+  ASSERT_EQ(send_order("V1", "v1-after-charge", {{"left-0", "NOP"}}), "");
+
+  const auto done = wait_order("v1-after-charge");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FINISHED) << done->failure();
+  std::lock_guard lock(seen_.mutex);
+  ASSERT_FALSE(seen_.holder_log["right-0"].empty()) << "V1 never went to the charger";
+  EXPECT_LE(seen_.holder_log["right-0"].front().first, done->started().ns())
+      << "V1 started its order before it charged";
+  EXPECT_EQ(seen_.holders["left-0"], "V1");
+  // Charged to 45 %, then drove 22 m (0.5 Wh/m) to left-0.
+  EXPECT_GT(seen_.latest["V1"].battery.state_of_charge, 0.3);
+  EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
 }
 
 }  // namespace
