@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <boost/geometry.hpp>
 #include <gtest/gtest.h>
 
 #include "agents/logical_agent/src/footprint_monitor.hpp"
@@ -216,9 +217,9 @@ TEST(FootprintMonitor, ReleasesWhatThePassedVehicleNoLongerTouches) {
   monitor.hold(next, 2);
   // Still at the start: nothing to release, the edge ahead is not passed.
   EXPECT_TRUE(monitor.releasable(status_at(0, 0, 1.5707963).footprint, 0).empty());
-  // Leaving: the footprint still touches left-0.
-  EXPECT_TRUE(monitor.releasable(status_at(0, 0.5, 1.5707963).footprint, 0).empty());
-  // Clear of left-0, on the edge.
+  // Leaving, half on left-0 and half on the edge: left-0 is still needed.
+  EXPECT_TRUE(monitor.releasable(status_at(0, 0.3, 1.5707963).footprint, 0).empty());
+  // On the edge, clear of left-0.
   EXPECT_EQ(monitor.releasable(status_at(0, 1.5, 1.5707963).footprint, 0), std::vector{start});
   monitor.drop(start);
   // Arrived at left-1: the edge is passed and no longer touched.
@@ -228,6 +229,27 @@ TEST(FootprintMonitor, ReleasesWhatThePassedVehicleNoLongerTouches) {
   monitor.forget_steps();
   const auto leftovers = monitor.releasable(status_at(0, 3, 1.5707963).footprint, 0);
   EXPECT_EQ(leftovers, (std::vector{index(*world, "bar-1"), edge})) << "ascending by entity";
+}
+
+TEST(FootprintMonitor, ReleasesWhatThePassedVehicleTouchesButNoLongerNeeds) {
+  const auto world = h_crossing();
+  FootprintMonitor monitor(world);
+  const auto start = index(*world, "left-0");
+  const auto edge = index(*world, "left-0<->left-1");
+  const auto next = index(*world, "left-1");
+  monitor.hold(start, 0);
+  monitor.hold(edge, 1);
+  // On left-1, turned across the aisle: the footprint touches the edge's strip beside it.
+  const auto footprint = status_at(0.3, 3).footprint;
+  ASSERT_TRUE(boost::geometry::intersects(footprint, world->footprint(edge)));
+  // Without left-1 held, the edge is still needed.
+  EXPECT_EQ(monitor.releasable(footprint, 2), std::vector{start});
+  // With left-1 held, the footprint lies inside left-1's own footprint, so the edge can go
+  // (a route stepping aside onto left-1 lets another vehicle use the edge meanwhile).
+  monitor.hold(next, 2);
+  EXPECT_EQ(monitor.releasable(footprint, 2), (std::vector{start, edge}));
+  // Not passed yet: kept, however covered.
+  EXPECT_EQ(monitor.releasable(footprint, 0), std::vector{start});
 }
 
 // ---- vehicle profiles ----

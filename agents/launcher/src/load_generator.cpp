@@ -87,6 +87,12 @@ void LoadGenerator::on_progress(const msg::OrderProgress& progress) {
     outstanding_.erase(ours);
     (progress.state() == msg::ORDER_FINISHED ? figures_.finished : figures_.failed) += 1;
     vehicle = progress.vehicle();
+    // Destination 0 loads; failing after it leaves the load on the vehicle.
+    if (progress.state() == msg::ORDER_FAILED && progress.destination() >= 1) {
+      may_carry_.insert(vehicle);
+    } else if (progress.state() == msg::ORDER_FINISHED) {
+      may_carry_.erase(vehicle);
+    }
   }
   if (progress.state() == msg::ORDER_FAILED) {
     spdlog::warn("order '{}' of vehicle '{}' failed: {}", progress.order(), vehicle, progress.failure());
@@ -104,6 +110,7 @@ void LoadGenerator::consider(const std::string& vehicle) {
     if (options_.max_orders != 0 && next_number_ > options_.max_orders) return;
     order = options_.order_prefix + "-" + std::to_string(next_number_++);
     stations = picker_.next();
+    if (may_carry_.contains(vehicle)) stations.first.clear();
     outstanding_[vehicle] = order;  // claimed before sending: the other reader sends nothing
   }
   send(vehicle, order, stations.first, stations.second);
@@ -113,7 +120,11 @@ void LoadGenerator::send(const std::string& vehicle, const std::string& order, c
                          const std::string& to) {
   msg::OrderRequest request;
   request.order(order);
-  request.destinations({destination(from, "load"), destination(to, "unload")});
+  if (from.empty()) {
+    request.destinations({destination(to, "unload")});
+  } else {
+    request.destinations({destination(from, "load"), destination(to, "unload")});
+  }
   auto reply = orders_->call(request, options_.request_timeout, vehicle);
   std::string problem;
   if (!reply) {
@@ -124,7 +135,11 @@ void LoadGenerator::send(const std::string& vehicle, const std::string& order, c
   std::lock_guard lock(mutex_);
   if (problem.empty()) {
     ++figures_.queued;
-    spdlog::info("order '{}' to '{}': load at {}, unload at {}", order, vehicle, from, to);
+    if (from.empty()) {
+      spdlog::info("order '{}' to '{}': unload at {} (what an earlier order may have left on it)", order, vehicle, to);
+    } else {
+      spdlog::info("order '{}' to '{}': load at {}, unload at {}", order, vehicle, from, to);
+    }
     return;
   }
   ++figures_.refused;

@@ -359,6 +359,11 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
       // Allocation ahead, in route order, within the look-ahead.
       while (auto next = route_->next_to_allocate(route_->position_step(), options_.lookahead)) {
         const auto entity = route_->step(*next).entity;
+        // A route may come back to an entity the vehicle still holds from an earlier step
+        // (it stepped aside to let another pass). That is a later reservation: it is asked
+        // for only once the earlier one is released, so it waits its turn behind whoever
+        // passes in between (asking now would only report the holding we have).
+        if (monitor_.holds(entity)) break;
         auto outcome = services_->allocate(vehicle_id(), entity, options_.allocate_wait);
         if (!outcome) {
           // Our reservation there is gone (cancelled, or the topology agent lost it): the

@@ -42,12 +42,21 @@ double FootprintMonitor::area_outside(const topology::Polygon& footprint) const 
   return ran::area_outside(footprint, *area_);
 }
 
+bool FootprintMonitor::covered_without(const topology::Polygon& footprint, topology::EntityIndex entity) const {
+  ran::MotionArea others;
+  for (const auto& [other, step] : held_) {
+    if (other != entity) others.push_back(topology_->footprint(other));
+  }
+  if (others.empty()) return false;
+  return ran::area_outside(footprint, ran::normalized_area(others)) <= tolerance_m2_;
+}
+
 std::vector<topology::EntityIndex> FootprintMonitor::releasable(const topology::Polygon& footprint,
                                                                 std::size_t passed_step) const {
   std::vector<topology::EntityIndex> out;
   for (const auto& [entity, step] : held_) {
     if (step && *step > passed_step) continue;
-    if (bg::intersects(footprint, topology_->footprint(entity))) continue;
+    if (bg::intersects(footprint, topology_->footprint(entity)) && !covered_without(footprint, entity)) continue;
     out.push_back(entity);
   }
   return out;

@@ -33,12 +33,20 @@ class FootprintMonitor {
   /// Whether `footprint` lies inside the held footprints (within the tolerance).
   bool inside(const topology::Polygon& footprint) const { return area_outside(footprint) <= tolerance_m2_; }
 
-  /// Held entities `footprint` does not touch whose step is at most `passed_step` (the
-  /// vehicle is past them) or that are leftovers, ascending by entity.
+  /// Held entities whose step is at most `passed_step` (the vehicle is past them) or that
+  /// are leftovers, and which `footprint` no longer needs: it does not touch them, or lies
+  /// inside the other held entities' footprints (within the tolerance). Ascending by entity.
+  /// Releasing an entity the footprint still touches is safe in the second case: the
+  /// vehicle stays inside entities it holds, and no other agent holds anything whose
+  /// footprint overlaps those (I1). It matters: a vehicle standing on a vertex always
+  /// touches the edge it came by, and a route that steps aside onto a vertex and comes
+  /// back must give that edge and the vertex it left to the agent passing in between.
   std::vector<topology::EntityIndex> releasable(const topology::Polygon& footprint, std::size_t passed_step) const;
 
  private:
   void rebuild_area() const;
+  /// Whether `footprint` lies inside the held footprints other than `entity`'s.
+  bool covered_without(const topology::Polygon& footprint, topology::EntityIndex entity) const;
 
   std::shared_ptr<const topology::Topology> topology_;
   double tolerance_m2_;

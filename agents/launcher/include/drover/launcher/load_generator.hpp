@@ -65,6 +65,7 @@ class LoadGenerator {
   void on_progress(const msg::OrderProgress& progress);
   /// Sends the next order to `vehicle` if it is free; called on either reader's thread.
   void consider(const std::string& vehicle);
+  /// Sends `load` at `from` (unless empty), then `unload` at `to`.
   void send(const std::string& vehicle, const std::string& order, const std::string& from,
             const std::string& to);
 
@@ -75,6 +76,9 @@ class LoadGenerator {
   StationPicker picker_;
   std::map<std::string, msg::VehicleState> vehicles_;   ///< latest state per vehicle
   std::map<std::string, std::string> outstanding_;      ///< vehicle -> our order
+  /// Vehicles whose order failed after its load: they may still carry it, so their next
+  /// order only unloads (a load on a loaded vehicle fails).
+  std::set<std::string> may_carry_;
   std::uint64_t next_number_ = 1;
   LoadFigures figures_;
 
