@@ -202,6 +202,7 @@ struct Observations {
   std::map<std::string, std::vector<std::pair<TimeNs, TimeNs>>> on_bar;  ///< vehicle -> times on bar-2
   std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, allocated to)
   std::uint64_t last_serial = 0;                                    ///< of the last topology event
+  std::vector<std::string> cancelled;                               ///< agents whose route was cancelled
 
   bool wait(const std::function<bool()>& condition, std::chrono::seconds timeout) {
     std::unique_lock lock(mutex);
@@ -292,6 +293,7 @@ class FleetTest : public ::testing::Test {
                                       std::to_string(seen_.last_serial) + ": events lost or out of order");
     }
     seen_.last_serial = event.serial();
+    if (event.kind() == msg::EVENT_CANCELLED) seen_.cancelled.push_back(event.agent());
     if (event.kind() == msg::EVENT_RELEASED) {
       if (seen_.holders[event.entity()] == event.agent()) seen_.holders[event.entity()].clear();
     } else if (event.kind() == msg::EVENT_ALLOCATED) {
@@ -686,6 +688,38 @@ TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
   // Charged to 45 %, then drove 22 m (0.5 Wh/m) to left-0.
   EXPECT_GT(seen_.latest["V1"].battery.state_of_charge, 0.3);
   EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
+}
+
+TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
+  constexpr std::uint32_t kDomain = 193;
+  Fleet fleet(kDomain, "fatal");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  fleet.start_vehicle("V1", "left-0");
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "v1-fatal", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::battery_failure, 0, 10s));
+
+  const auto done = wait_order("v1-fatal");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FAILED);
+  EXPECT_NE(done->failure().find("battery_failure"), std::string::npos) << done->failure();
+  // The route ahead is given up on the topology agent.
+  EXPECT_TRUE(seen_.wait(
+      [&] { return std::find(seen_.cancelled.begin(), seen_.cancelled.end(), "V1") != seen_.cancelled.end(); }, 60s))
+      << "V1's route was not cancelled";
+  std::lock_guard lock(seen_.mutex);
+  bool critical = false;
+  for (const auto& alarm : seen_.alarms) {
+    critical = critical || (alarm.severity() == msg::ALARM_CRITICAL && alarm.vehicle() == "V1" &&
+                            alarm.text().find("battery_failure") != std::string::npos);
+  }
+  EXPECT_TRUE(critical) << "no critical alarm naming the RAN error";
+  for (const auto* ahead : {"left-2", "bar-2", "right-4"}) {
+    EXPECT_NE(seen_.holders[ahead], "V1") << "V1 still holds " << ahead;
+  }
 }
 
 }  // namespace

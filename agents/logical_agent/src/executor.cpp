@@ -321,7 +321,12 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
           failure = fmt::format("move to '{}' {}: {} {}", topology_->id(route_->step(target).entity),
                                 ran::to_string(ended->second.state), ended->second.code, ended->second.reason);
           lock.unlock();
-          raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+          // A move fails when the vehicle breaks down: that is critical, as check_errors says.
+          const auto status = latest_status();
+          const bool fatal = status && std::any_of(status->errors.begin(), status->errors.end(), [](const auto& e) {
+                               return e.level == ran::ErrorLevel::fatal;
+                             });
+          raise_alarm(fatal ? msg::ALARM_CRITICAL : msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
           stop_vehicle();
           return FollowResult::failed;
         }
