@@ -272,6 +272,16 @@ class FleetTest : public ::testing::Test {
         *participant_, logical_agent::kServiceArea, logical_agent::kOrderService);
     ASSERT_TRUE(orders.has_value());
     order_client_ = std::move(*orders);
+    // Nothing the topology agent does may be missed.
+    ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+  }
+
+  /// Whether `vehicle` raised an alarm of `severity` whose text contains `part`.
+  /// \pre seen_.mutex is held
+  bool alarm_seen(msg::AlarmSeverity severity, const std::string& vehicle, const std::string& part) const {
+    return std::any_of(seen_.alarms.begin(), seen_.alarms.end(), [&](const msg::OperatorAlarm& alarm) {
+      return alarm.severity() == severity && alarm.vehicle() == vehicle && alarm.text().find(part) != std::string::npos;
+    });
   }
 
   void TearDown() override {
@@ -374,6 +384,14 @@ class FleetTest : public ::testing::Test {
         timeout);
   }
 
+  /// Starts vehicle V1 on left-0, sends it order `name` to right-4 and waits until it drives.
+  void send_v1_across(Fleet& fleet, const std::string& name) {
+    fleet.start_vehicle("V1", "left-0");
+    ASSERT_TRUE(wait_ready("V1", "left-0"));
+    ASSERT_EQ(send_order("V1", name, {{"right-4", "NOP"}}), "");
+    ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  }
+
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
   bool wait_ready(const std::string& vehicle, const std::string& vertex) {
     return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
@@ -396,7 +414,6 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
   Fleet fleet(kDomain, "crossing");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   fleet.start_vehicle("V1", "left-0");
   fleet.start_vehicle("V2", "right-0");
   ASSERT_TRUE(wait_ready("V1", "left-0"));
@@ -442,7 +459,6 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   Fleet fleet(kDomain, "stall");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   fleet.start_vehicle("V1", "left-0");
   fleet.start_vehicle("V2", "right-0");
   ASSERT_TRUE(wait_ready("V1", "left-0"));
@@ -509,17 +525,8 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
   Fleet fleet(kDomain, "lock");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
-  fleet.start_vehicle("V1", "left-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_EQ(send_order("V1", "v1-lock", {{"right-4", "NOP"}}), "");
   // Once V1 has its route (it moves), lock bar-3 ahead of it for 30 s.
-  ASSERT_TRUE(seen_.wait(
-      [&] {
-        auto found = seen_.latest.find("V1");
-        return found != seen_.latest.end() && found->second.pose.y > 0.5;
-      },
-      120s));
+  ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-lock"));
   auto lock_client = dds::ServiceClient<msg::LockRequest, msg::LockReply>::create(*participant_, "topology", "lock");
   ASSERT_TRUE(lock_client.has_value());
   msg::LockRequest lock;
@@ -560,7 +567,6 @@ TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
   Fleet fleet(kDomain, "restart");
   fleet.start_infrastructure("topology.db");
   watch(kDomain, fleet, {"V1", "V2"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   fleet.start_vehicle("V1", "left-0");
   fleet.start_vehicle("V2", "right-0");
   ASSERT_TRUE(wait_ready("V1", "left-0"));
@@ -595,7 +601,6 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   Fleet fleet(kDomain, "drift");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   // V1's RAN runs in this process, so that the test can make its vehicle drift.
   ran::SimVehicleConfig config;
   config.vehicle_id = "V1";
@@ -624,12 +629,7 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   // The vehicle is stopped: it comes to stand and stays there.
   EXPECT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed == 0.0; }, 60s));
   std::lock_guard lock(seen_.mutex);
-  bool critical = false;
-  for (const auto& alarm : seen_.alarms) {
-    critical = critical || (alarm.severity() == msg::ALARM_CRITICAL && alarm.vehicle() == "V1" &&
-                            alarm.text().find("left its allocated area") != std::string::npos);
-  }
-  EXPECT_TRUE(critical) << "no critical alarm about the footprint";
+  EXPECT_TRUE(alarm_seen(msg::ALARM_CRITICAL, "V1", "left its allocated area")) << "no critical alarm about the footprint";
   EXPECT_TRUE(seen_.latest["V1"].pose.y < 6.0) << "V1 drove on to the bar after leaving its area";
   // Stopping the logical agent before the in-process RAN goes away.
   fleet.stop();
@@ -640,7 +640,6 @@ TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
   Fleet fleet(kDomain, "park");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   // V2 stands on left-0, the parking vertex nearest to V1: V1 must take the other one.
   fleet.start_vehicle("V2", "left-0");
   ASSERT_TRUE(wait_ready("V2", "left-0"));
@@ -670,7 +669,6 @@ TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
   fleet.use_topology(file);
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
   // 15 Wh of 100: under the 20 % threshold; charging takes it to 45 % (1 Wh/s).
   fleet.start_vehicle("V1", "left-4", {"--battery-capacity", "100", "--battery", "15"},
                       {"--park-after", "-1", "--charge-below", "0.2", "--charge-to", "0.45"});
@@ -695,11 +693,7 @@ TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
   Fleet fleet(kDomain, "fatal");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
-  fleet.start_vehicle("V1", "left-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_EQ(send_order("V1", "v1-fatal", {{"right-4", "NOP"}}), "");
-  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-fatal"));
   ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::battery_failure, 0, 10s));
 
   const auto done = wait_order("v1-fatal");
@@ -711,12 +705,7 @@ TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
       [&] { return std::find(seen_.cancelled.begin(), seen_.cancelled.end(), "V1") != seen_.cancelled.end(); }, 60s))
       << "V1's route was not cancelled";
   std::lock_guard lock(seen_.mutex);
-  bool critical = false;
-  for (const auto& alarm : seen_.alarms) {
-    critical = critical || (alarm.severity() == msg::ALARM_CRITICAL && alarm.vehicle() == "V1" &&
-                            alarm.text().find("battery_failure") != std::string::npos);
-  }
-  EXPECT_TRUE(critical) << "no critical alarm naming the RAN error";
+  EXPECT_TRUE(alarm_seen(msg::ALARM_CRITICAL, "V1", "battery_failure")) << "no critical alarm naming the RAN error";
   for (const auto* ahead : {"left-2", "bar-2", "right-4"}) {
     EXPECT_NE(seen_.holders[ahead], "V1") << "V1 still holds " << ahead;
   }

@@ -206,14 +206,20 @@ TEST(FootprintMonitor, FootprintMustStayInsideTheHeldEntities) {
   EXPECT_FALSE(monitor.inside(status_at(1.0, 1.0).footprint)) << "beside the edge";
 }
 
-TEST(FootprintMonitor, ReleasesWhatThePassedVehicleNoLongerTouches) {
-  const auto world = h_crossing();
-  FootprintMonitor monitor(world);
-  const auto start = index(*world, "left-0");
-  const auto edge = index(*world, "left-0<->left-1");
-  const auto next = index(*world, "left-1");
-  monitor.hold(start, 0);
-  monitor.hold(edge, 1);
+/// A vehicle leaving left-0 for left-1, holding left-0 (step 0) and the edge (step 1).
+struct LeavingLeft0 : ::testing::Test {
+  std::shared_ptr<const topology::Topology> world = h_crossing();
+  FootprintMonitor monitor{world};
+  topology::EntityIndex start = index(*world, "left-0");
+  topology::EntityIndex edge = index(*world, "left-0<->left-1");
+  topology::EntityIndex next = index(*world, "left-1");
+  LeavingLeft0() {
+    monitor.hold(start, 0);
+    monitor.hold(edge, 1);
+  }
+};
+
+TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleNoLongerTouches) {
   monitor.hold(next, 2);
   // Still at the start: nothing to release, the edge ahead is not passed.
   EXPECT_TRUE(monitor.releasable(status_at(0, 0, 1.5707963).footprint, 0).empty());
@@ -231,14 +237,7 @@ TEST(FootprintMonitor, ReleasesWhatThePassedVehicleNoLongerTouches) {
   EXPECT_EQ(leftovers, (std::vector{index(*world, "bar-1"), edge})) << "ascending by entity";
 }
 
-TEST(FootprintMonitor, ReleasesWhatThePassedVehicleTouchesButNoLongerNeeds) {
-  const auto world = h_crossing();
-  FootprintMonitor monitor(world);
-  const auto start = index(*world, "left-0");
-  const auto edge = index(*world, "left-0<->left-1");
-  const auto next = index(*world, "left-1");
-  monitor.hold(start, 0);
-  monitor.hold(edge, 1);
+TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleTouchesButNoLongerNeeds) {
   // On left-1, turned across the aisle: the footprint touches the edge's strip beside it.
   const auto footprint = status_at(0.3, 3).footprint;
   ASSERT_TRUE(boost::geometry::intersects(footprint, world->footprint(edge)));
