@@ -66,7 +66,7 @@ constexpr auto kStartTimeout = 20s;
 constexpr auto kCallTimeout = 5s;
 
 struct RpcArguments {
-  std::uint32_t domain_id = 231;
+  std::uint32_t domain_id = 99;
   int calls = 2000;
   int warmup = 200;
   std::size_t payload_bytes = 512;
@@ -442,7 +442,7 @@ void add_bench_rpc_command(CLI::App& bench, cli::CommandContext& context) {
   auto arguments = std::make_shared<RpcArguments>();
   auto* rpc = bench.add_subcommand(
       "rpc", "Request/reply round trips over the DDS service layer vs a raw DDS ping-pong");
-  rpc->add_option("--domain", arguments->domain_id, "DDS domain id (default 231)")->check(CLI::Range(0, 232));
+  rpc->add_option("--domain", arguments->domain_id, "DDS domain id (default 99)")->check(CLI::Range(0, 232));
   rpc->add_option("--calls", arguments->calls, "Measured round trips of each kind (default 2000)")
       ->check(CLI::Range(1, 10'000'000));
   rpc->add_option("--warmup", arguments->warmup, "Unmeasured round trips first (default 200)")

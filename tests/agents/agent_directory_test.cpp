@@ -28,7 +28,7 @@ class AgentDirectoryTest : public ::testing::Test {
 };
 
 TEST_F(AgentDirectoryTest, SeesAHeartbeatAndNoticesWhenItsAgentIsKilled) {
-  constexpr std::uint32_t kDomain = 110;
+  constexpr std::uint32_t kDomain = 20;
   auto peer = spawn_peer(kDomain, "router-1", {"--heartbeat", "routing", "--owns", "zone-a", "--owns", "zone-b"});
   ASSERT_TRUE(peer.has_value());
   peers_.push_back(std::move(*peer));
@@ -75,7 +75,7 @@ TEST_F(AgentDirectoryTest, SeesAHeartbeatAndNoticesWhenItsAgentIsKilled) {
 }
 
 TEST_F(AgentDirectoryTest, NoticesADroppedParticipantWithoutTheDeadline) {
-  constexpr std::uint32_t kDomain = 111;
+  constexpr std::uint32_t kDomain = 21;
   auto peer = spawn_peer(kDomain, "logical-9", {"--heartbeat", "logical"});
   ASSERT_TRUE(peer.has_value());
   peers_.push_back(std::move(*peer));

@@ -37,7 +37,7 @@ class DroverctlTest : public ::testing::Test {
 };
 
 TEST_F(DroverctlTest, AgentsListsTheLiveAgentsWithKindAndWhatTheyOwn) {
-  constexpr std::uint32_t kDomain = 140;
+  constexpr std::uint32_t kDomain = 40;
   for (auto [id, kind, owns] : std::vector<std::tuple<std::string, std::string, std::string>>{
            {"router-1", "routing", "zone-a"}, {"topo-east", "topology", "east"}}) {
     auto peer = spawn_peer(kDomain, id, {"--heartbeat", kind, "--owns", owns});
@@ -77,11 +77,11 @@ TEST_F(DroverctlTest, AgentsListsTheLiveAgentsWithKindAndWhatTheyOwn) {
 
 TEST_F(DroverctlTest, AgentsExitsWithCode3WhenNobodyAnswers) {
   std::string out, err;
-  auto status = run_droverctl({"agents", "--domain", "141", "--timeout", "0.5"}, out, err);
+  auto status = run_droverctl({"agents", "--domain", "41", "--timeout", "0.5"}, out, err);
   ASSERT_TRUE(status.has_value());
   ASSERT_TRUE(status->exited);
   EXPECT_EQ(status->code, 3);
-  EXPECT_NE(err.find("no agent answered on domain 141 within 0.5 s"), std::string::npos) << err;
+  EXPECT_NE(err.find("no agent answered on domain 41 within 0.5 s"), std::string::npos) << err;
   EXPECT_TRUE(out.empty()) << out;
 }
 

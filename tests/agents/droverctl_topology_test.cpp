@@ -1,5 +1,5 @@
 // droverctl lock / unlock / timeline run as processes against a real topology agent
-// (`drover topology-agent`), domains 171..175. A lock that hits a committed reservation
+// (`drover topology-agent`), domains 61..65. A lock that hits a committed reservation
 // makes the agent send its owner NOTICE_LOCK_HIT over DDS, seen by this test's reader.
 
 #include <signal.h>
@@ -77,7 +77,7 @@ class DroverctlTopologyTest : public ::testing::Test {
 };
 
 TEST_F(DroverctlTopologyTest, LockHitsAReservationAndNotifiesItsOwnerTimelineShowsItUnlockRemovesIt) {
-  constexpr std::uint32_t kDomain = 171;
+  constexpr std::uint32_t kDomain = 61;
   start_agent(kDomain);
   participant_ = make_participant(kDomain, "v1");
   ASSERT_NE(participant_, nullptr);
@@ -173,7 +173,7 @@ TEST_F(DroverctlTopologyTest, LockHitsAReservationAndNotifiesItsOwnerTimelineSho
 }
 
 TEST_F(DroverctlTopologyTest, BadInputIsExit2AndNoAgentIsExit3) {
-  constexpr std::uint32_t kDomain = 172;
+  constexpr std::uint32_t kDomain = 62;
   start_agent(kDomain);
   const std::string domain = std::to_string(kDomain);
   std::string out, err;
@@ -189,10 +189,10 @@ TEST_F(DroverctlTopologyTest, BadInputIsExit2AndNoAgentIsExit3) {
             2);
   EXPECT_NE(err.find("unknown entity 'nowhere'"), std::string::npos) << err;
   EXPECT_EQ(droverctl({"unlock", "garbage", "--domain", domain}, out, err), 2);
-  EXPECT_EQ(droverctl({"timeline", "a", "--domain", "173", "--timeout", "1"}, out, err), 3);
-  EXPECT_NE(err.find("no topology agent answered on domain 173"), std::string::npos) << err;
-  EXPECT_EQ(droverctl({"unlock", "topology/1", "--domain", "173", "--timeout", "1"}, out, err), 3);
-  EXPECT_EQ(droverctl({"lock", "a", "--from", "now", "--until", "+1m", "--reason", "r", "--domain", "173",
+  EXPECT_EQ(droverctl({"timeline", "a", "--domain", "63", "--timeout", "1"}, out, err), 3);
+  EXPECT_NE(err.find("no topology agent answered on domain 63"), std::string::npos) << err;
+  EXPECT_EQ(droverctl({"unlock", "topology/1", "--domain", "63", "--timeout", "1"}, out, err), 3);
+  EXPECT_EQ(droverctl({"lock", "a", "--from", "now", "--until", "+1m", "--reason", "r", "--domain", "63",
                        "--timeout", "1"},
                       out, err),
             3);

@@ -48,7 +48,7 @@ class ServiceTest : public ::testing::Test {
 };
 
 TEST_F(ServiceTest, ConcurrentClientsEachGetTheirOwnReplies) {
-  constexpr std::uint32_t kDomain = 101;
+  constexpr std::uint32_t kDomain = 11;
   constexpr int kClients = 3;
   constexpr int kThreadsPerClient = 2;
   constexpr int kCallsPerThread = 20;
@@ -117,7 +117,7 @@ TEST_F(ServiceTest, NoServerIsATimeoutThatSaysNoServerMatched) {
 }
 
 TEST_F(ServiceTest, ServerThatDoesNotAnswerIsATimeoutThatNamesIt) {
-  constexpr std::uint32_t kDomain = 103;
+  constexpr std::uint32_t kDomain = 13;
   start_peer(kDomain, "slow-server");
   auto participant = make_participant(kDomain, "impatient-client");
   ASSERT_NE(participant, nullptr);
@@ -135,7 +135,7 @@ TEST_F(ServiceTest, ServerThatDoesNotAnswerIsATimeoutThatNamesIt) {
 }
 
 TEST_F(ServiceTest, DeferredReplyArrivesWhenTheServerCompletesIt) {
-  constexpr std::uint32_t kDomain = 104;
+  constexpr std::uint32_t kDomain = 14;
   start_peer(kDomain, "deferring-server");
   auto participant = make_participant(kDomain, "patient-client");
   ASSERT_NE(participant, nullptr);
@@ -168,7 +168,7 @@ TEST_F(ServiceTest, DeferredReplyArrivesWhenTheServerCompletesIt) {
 }
 
 TEST_F(ServiceTest, CallFailsWhenItsServerDiesWhileHoldingIt) {
-  constexpr std::uint32_t kDomain = 105;
+  constexpr std::uint32_t kDomain = 15;
   start_peer(kDomain, "doomed-server");
   auto participant = make_participant(kDomain, "orphaned-client");
   ASSERT_NE(participant, nullptr);
@@ -194,7 +194,7 @@ TEST_F(ServiceTest, CallFailsWhenItsServerDiesWhileHoldingIt) {
 }
 
 TEST_F(ServiceTest, RequestsGoToTheNamedServerOrToEachServerInTurn) {
-  constexpr std::uint32_t kDomain = 106;
+  constexpr std::uint32_t kDomain = 16;
   start_peer(kDomain, "echo-a");
   start_peer(kDomain, "echo-b");
   auto participant = make_participant(kDomain, "choosy-client");

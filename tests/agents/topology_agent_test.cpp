@@ -1,5 +1,5 @@
 // The topology agent as a process (`drover topology-agent`): the test process is its
-// client over DDS. Domains 210..218. Every agent is stopped with SIGTERM and must exit 0.
+// client over DDS. Domains 60 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 
@@ -301,8 +301,8 @@ class TopologyAgentTest : public ::testing::Test {
 };
 
 TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingPrepareChangesNothing) {
-  start_agent(210);
-  connect(210);
+  start_agent(70);
+  connect(70);
   ASSERT_EQ(timeline("a").version(), 0u);
 
   reserve("v1", 1, {{"a", {1000, 2000}}});
@@ -338,8 +338,8 @@ TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingP
 }
 
 TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequesterIsAnsweredOnRelease) {
-  start_agent(211);
-  connect(211);
+  start_agent(71);
+  connect(71);
   reserve("v1", 1, {{"b", {1000, 2000}}});
   reserve("v2", 1, {{"b", {3000, 4000}}});
 
@@ -373,8 +373,8 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequest
 }
 
 TEST_F(TopologyAgentTest, ALockNotifiesTheOwnersOfHitReservationsAndUnlockRemovesIt) {
-  start_agent(212);
-  connect(212);
+  start_agent(72);
+  connect(72);
   reserve("v1", 4, {{"c", {100, 200}}});
   const auto locked = lock("c", 150, 300);
   ASSERT_EQ(locked.error().code(), msg::ERROR_NONE) << locked.error().message();
@@ -406,8 +406,8 @@ TEST_F(TopologyAgentTest, ALockNotifiesTheOwnersOfHitReservationsAndUnlockRemove
 }
 
 TEST_F(TopologyAgentTest, BadRequestsGetAnErrorReplyAndChangeNothing) {
-  start_agent(213);
-  connect(213);
+  start_agent(73);
+  connect(73);
   reserve("v1", 1, {{"a", {1000, 2000}}});
   const auto before = timeline_at("a", 2);
 
@@ -451,8 +451,8 @@ TEST_F(TopologyAgentTest, BadRequestsGetAnErrorReplyAndChangeNothing) {
 }
 
 TEST_F(TopologyAgentTest, DelayShiftsThePushedRouteAndNotifiesEveryAffectedAgent) {
-  start_agent(214);
-  connect(214);
+  start_agent(74);
+  connect(74);
   reserve("v1", 1, {{"a", {1000, 2000}}});
   reserve("v2", 1, {{"a", {2000, 3000}}});
   msg::DelayRequest request;
@@ -486,8 +486,8 @@ TEST_F(TopologyAgentTest, DelayShiftsThePushedRouteAndNotifiesEveryAffectedAgent
 }
 
 TEST_F(TopologyAgentTest, EveryReservationAllocationAndReleaseIsPublishedAsAnEvent) {
-  start_agent(170);
-  connect(170);
+  start_agent(60);
+  connect(60);
   reserve("v1", 1, {{"a", {1000, 2000}}});
   reserve("v2", 5, {{"a", {3000, 4000}}});
   EXPECT_TRUE(allocate("v1", "a", false).granted());
@@ -533,9 +533,9 @@ TEST_F(TopologyAgentTest, EveryReservationAllocationAndReleaseIsPublishedAsAnEve
 }
 
 TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
-  start_agent(215, {"--partition", "west"});
-  start_agent(215, {"--partition", "east"});
-  connect(215);
+  start_agent(75, {"--partition", "west"});
+  start_agent(75, {"--partition", "east"});
+  connect(75);
   EXPECT_TRUE(wait_until([&] { return descriptions_.size() == topology_->entity_count(); }));
   {
     std::lock_guard guard(mutex_);
@@ -585,8 +585,8 @@ TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
 }
 
 TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
-  start_agent(216);
-  connect(216);
+  start_agent(76);
+  connect(76);
   auto prepared = prepare_->call(
       prepare_request("v1", 1, items("v1", 1, {{"b", {1000, 2000}}}), {}, SharedClock::wall().now() + seconds_to_ns(1)),
       kDiscoveryTimeout);
@@ -610,8 +610,8 @@ TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
 TEST_F(TopologyAgentTest, AfterKill9TheRestartedAgentHasItsCommittedStateBack) {
   const auto journal = std::filesystem::path(topology_file_).replace_extension(".db");
   std::filesystem::remove(journal);
-  start_agent(217, {"--db", journal.string()});
-  connect(217);
+  start_agent(77, {"--db", journal.string()});
+  connect(77);
   std::atomic<bool> gone{false};
   const auto token = participant_->subscribe_events([&](const dds::ParticipantEvent& event) {
     if (event.name == "topology" && event.change != dds::ParticipantChange::discovered) gone = true;
@@ -632,7 +632,7 @@ TEST_F(TopologyAgentTest, AfterKill9TheRestartedAgentHasItsCommittedStateBack) {
     std::lock_guard guard(mutex_);
     timelines_.clear();
   }
-  start_agent(217, {"--db", journal.string()});
+  start_agent(77, {"--db", journal.string()});
   EXPECT_TRUE(wait_until([&] { return timelines_.count("a") > 0 && timelines_.count("c") > 0; }));
   {
     std::lock_guard guard(mutex_);
@@ -653,7 +653,7 @@ TEST_F(TopologyAgentTest, AfterKill9TheRestartedAgentHasItsCommittedStateBack) {
 TEST(TopologyAgentCommand, APartitionThatOwnsNothingIsBadInput) {
   const auto file = write_topology_file();
   auto agent = ChildProcess::spawn(binary_path("drover"),
-                                   {"topology-agent", "--topology", file, "--partition", "north", "--domain", "218"});
+                                   {"topology-agent", "--topology", file, "--partition", "north", "--domain", "78"});
   ASSERT_TRUE(agent.has_value());
   auto status = agent->wait_exit(kDiscoveryTimeout);
   ASSERT_TRUE(status.has_value());

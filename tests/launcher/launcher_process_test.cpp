@@ -1,4 +1,4 @@
-// `drover launch` as a process (domains 226..229): it starts the agents of a launch file,
+// `drover launch` as a process (domains 94..97): it starts the agents of a launch file,
 // prefixes their lines with their agent ids, restarts a crashed agent whose entry says so,
 // stops on SIGTERM and after --duration with exit 0, exits 1 when an agent failed for good
 // and 2 for a bad launch file, before starting anything.
@@ -32,7 +32,7 @@ std::vector<pid_t> started_pids(const std::string& output, const std::string& id
 
 TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
   const auto dir = scratch_dir("launch_restart");
-  write_text(dir / "fleet.json", loop_launch(226, R"(
+  write_text(dir / "fleet.json", loop_launch(74, R"(
       {"kind": "topology"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
       {"kind": "ran-sim", "vehicle": "V2", "at": "north-east", "restart": "on-failure", "max_restarts": 3})"));
@@ -80,7 +80,7 @@ TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
 
 TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto dir = scratch_dir("launch_duration");
-  write_text(dir / "fleet.json", loop_launch(227, R"(
+  write_text(dir / "fleet.json", loop_launch(75, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   auto launcher = ChildProcess::spawn(
       binary_path("drover"),
@@ -106,7 +106,7 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
 TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
   const auto dir = scratch_dir("launch_failure");
   // The journal's directory does not exist: the topology agent exits 1, and is not restarted.
-  write_text(dir / "fleet.json", loop_launch(228, R"(
+  write_text(dir / "fleet.json", loop_launch(76, R"(
       {"kind": "topology", "db": "/nonexistent-dir/loop.db"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   auto launcher = ChildProcess::spawn(binary_path("drover"),
@@ -126,7 +126,7 @@ TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
 
 TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   const auto dir = scratch_dir("launch_bad");
-  write_text(dir / "fleet.json", loop_launch(229, R"(
+  write_text(dir / "fleet.json", loop_launch(77, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "atlantis"})"));
   auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
                                       (dir / "out.txt").string(), (dir / "err.txt").string());

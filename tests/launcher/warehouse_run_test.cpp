@@ -1,4 +1,4 @@
-// The short warehouse run (domain 230): launch/warehouse.json — two topology agents, a
+// The short warehouse run (domain 98): launch/warehouse.json — two topology agents, a
 // routing agent, 8 simulated vehicles with their logical agents, the load generator — runs
 // for a fixed simulated time at a high time factor. From its trace alone (no Drover code):
 // at least 20 orders finished, and no two vehicles' reported footprints overlap at any
@@ -124,7 +124,7 @@ TEST(WarehouseRun, EightVehiclesFinishTwentyOrdersWithoutOverlappingFootprints) 
   const auto trace_file = dir / "trace.jsonl";
   auto launcher = ChildProcess::spawn(binary_path("drover"),
                                       {"launch", (source_dir() / "launch" / "warehouse.json").string(), "--domain",
-                                       "230", "--time-factor", kTimeFactor, "--duration", kDurationS, "--trace",
+                                       "98", "--time-factor", kTimeFactor, "--duration", kDurationS, "--trace",
                                        trace_file.string()},
                                       (dir / "out.txt").string(), (dir / "err.txt").string());
   ASSERT_TRUE(launcher.has_value());

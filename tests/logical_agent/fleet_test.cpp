@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 186..199. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 86..93. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -410,7 +410,7 @@ class FleetTest : public ::testing::Test {
 };
 
 TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
-  constexpr std::uint32_t kDomain = 186;
+  constexpr std::uint32_t kDomain = -14;
   Fleet fleet(kDomain, "crossing");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -455,7 +455,7 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
 }
 
 TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
-  constexpr std::uint32_t kDomain = 187;
+  constexpr std::uint32_t kDomain = -13;
   Fleet fleet(kDomain, "stall");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -521,7 +521,7 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
 }
 
 TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
-  constexpr std::uint32_t kDomain = 188;
+  constexpr std::uint32_t kDomain = -12;
   Fleet fleet(kDomain, "lock");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
@@ -563,7 +563,7 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
 }
 
 TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
-  constexpr std::uint32_t kDomain = 189;
+  constexpr std::uint32_t kDomain = -11;
   Fleet fleet(kDomain, "restart");
   fleet.start_infrastructure("topology.db");
   watch(kDomain, fleet, {"V1", "V2"});
@@ -597,7 +597,7 @@ TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
 }
 
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
-  constexpr std::uint32_t kDomain = 190;
+  constexpr std::uint32_t kDomain = -10;
   Fleet fleet(kDomain, "drift");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
@@ -636,7 +636,7 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
 }
 
 TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
-  constexpr std::uint32_t kDomain = 191;
+  constexpr std::uint32_t kDomain = -9;
   Fleet fleet(kDomain, "park");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -657,7 +657,7 @@ TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
 }
 
 TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
-  constexpr std::uint32_t kDomain = 192;
+  constexpr std::uint32_t kDomain = -8;
   Fleet fleet(kDomain, "charge");
   // The H crossing with a charger at right-0.
   auto json = nlohmann::json::parse(std::ifstream(source_dir() + "/launch/topologies/h_crossing.json"));
@@ -689,7 +689,7 @@ TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
 }
 
 TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
-  constexpr std::uint32_t kDomain = 193;
+  constexpr std::uint32_t kDomain = -7;
   Fleet fleet(kDomain, "fatal");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});

@@ -2,7 +2,7 @@
 // partitions: test and real routes through the route service and droverctl route, bad
 // requests, many concurrent real routes through two routing agents (no double booking,
 // judged on the timelines the topology agents publish), and a routing agent killed
-// between prepare and commit. DDS domains 150..169. Nothing sleeps: every wait is on a
+// between prepare and commit. DDS domains 50..59. Nothing sleeps: every wait is on a
 // condition with a generous timeout.
 
 #include <signal.h>
@@ -235,7 +235,7 @@ class RoutingAgentTest : public ::testing::Test {
 };
 
 TEST_F(RoutingAgentTest, TestRouteReservesNothingRealRouteIsReservedOnBothPartitions) {
-  constexpr std::uint32_t kDomain = 150;
+  constexpr std::uint32_t kDomain = 50;
   use_line_topology();
   start_topology_agents(kDomain, topology_file_);
   start_routing_agent(kDomain, "routing-1");
@@ -309,7 +309,7 @@ TEST_F(RoutingAgentTest, TestRouteReservesNothingRealRouteIsReservedOnBothPartit
 }
 
 TEST_F(RoutingAgentTest, BadRequestsGetClearErrors) {
-  constexpr std::uint32_t kDomain = 151;
+  constexpr std::uint32_t kDomain = 51;
   use_line_topology();
   start_topology_agents(kDomain, topology_file_);
   start_routing_agent(kDomain, "routing-1", {"--learn-timeout", "1"});
@@ -362,7 +362,7 @@ TEST_F(RoutingAgentTest, BadRequestsGetClearErrors) {
                      out, err);
   EXPECT_EQ(status->code, 2) << err;
   EXPECT_NE(err.find("unknown vertex 'nowhere'"), std::string::npos) << err;
-  status = droverctl({"route", "a", "c", "--test", "--domain", "169", "--timeout", "0.5"}, out, err);
+  status = droverctl({"route", "a", "c", "--test", "--domain", "59", "--timeout", "0.5"}, out, err);
   EXPECT_EQ(status->code, 3) << err;
   EXPECT_NE(err.find("no routing agent answered"), std::string::npos) << err;
   status = droverctl({"route", "a"}, out, err);
@@ -373,7 +373,7 @@ TEST_F(RoutingAgentTest, BadRequestsGetClearErrors) {
 // Two topology agents (the warehouse's west and east), two routing agents, four client
 // processes sending 50 real routes each from 4 threads: 200 concurrent requests.
 TEST_F(RoutingAgentTest, ConcurrentRealRoutesThroughTwoRoutingAgentsNeverDoubleBook) {
-  constexpr std::uint32_t kDomain = 152;
+  constexpr std::uint32_t kDomain = 52;
   const std::string warehouse = source_path("launch/topologies/warehouse.json");
   auto topology = topology::load_topology_file(warehouse);
   ASSERT_TRUE(topology.has_value());
@@ -492,7 +492,7 @@ TEST_F(RoutingAgentTest, ConcurrentRealRoutesThroughTwoRoutingAgentsNeverDoubleB
 }
 
 TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire) {
-  constexpr std::uint32_t kDomain = 153;
+  constexpr std::uint32_t kDomain = 53;
   use_line_topology();
   start_topology_agents(kDomain, topology_file_);
   start_routing_agent(kDomain, "routing-held", {"--hold-after-prepare", "--prepare-ttl", "4"});
@@ -543,7 +543,7 @@ TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire
 // An operator's lock (droverctl lock, as a process) makes new routes go round the entity;
 // unlocking it (droverctl unlock) makes it usable again.
 TEST_F(RoutingAgentTest, LockMakesNewRoutesAvoidTheEntityAndUnlockRestoresIt) {
-  constexpr std::uint32_t kDomain = 154;
+  constexpr std::uint32_t kDomain = 54;
   use_topology(kDetourTopology);
   start_topology_agents(kDomain, topology_file_);
   start_routing_agent(kDomain, "routing-1");
