@@ -32,7 +32,7 @@ std::vector<pid_t> started_pids(const std::string& output, const std::string& id
 
 TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
   const auto dir = scratch_dir("launch_restart");
-  write_text(dir / "fleet.json", loop_launch(74, R"(
+  write_text(dir / "fleet.json", loop_launch(94, R"(
       {"kind": "topology"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
       {"kind": "ran-sim", "vehicle": "V2", "at": "north-east", "restart": "on-failure", "max_restarts": 3})"));
@@ -80,7 +80,7 @@ TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
 
 TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto dir = scratch_dir("launch_duration");
-  write_text(dir / "fleet.json", loop_launch(75, R"(
+  write_text(dir / "fleet.json", loop_launch(95, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   auto launcher = ChildProcess::spawn(
       binary_path("drover"),
@@ -106,7 +106,7 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
 TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
   const auto dir = scratch_dir("launch_failure");
   // The journal's directory does not exist: the topology agent exits 1, and is not restarted.
-  write_text(dir / "fleet.json", loop_launch(76, R"(
+  write_text(dir / "fleet.json", loop_launch(96, R"(
       {"kind": "topology", "db": "/nonexistent-dir/loop.db"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   auto launcher = ChildProcess::spawn(binary_path("drover"),
@@ -126,7 +126,7 @@ TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
 
 TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   const auto dir = scratch_dir("launch_bad");
-  write_text(dir / "fleet.json", loop_launch(77, R"(
+  write_text(dir / "fleet.json", loop_launch(97, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "atlantis"})"));
   auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
                                       (dir / "out.txt").string(), (dir / "err.txt").string());

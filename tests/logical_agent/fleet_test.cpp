@@ -78,9 +78,9 @@ class Fleet {
     auto full = args;
     full.insert(full.end(), {"--domain", std::to_string(domain_), "--time-factor", std::to_string(kTimeFactor),
                              "--epoch", std::to_string(origin_), "--clock-origin", std::to_string(origin_)});
-    const auto log = (dir_ / (name + ".log")).string();
-    // Appended, so that a restarted agent's log follows its first life's.
-    std::ofstream(log, std::ios::app) << "==== " << name << " started\n";
+    // A restarted agent logs to NAME.restarted.log, so that its first life's log stays.
+    auto log = (dir_ / (name + ".log")).string();
+    if (std::filesystem::exists(log)) log = (dir_ / (name + ".restarted.log")).string();
     auto child = ChildProcess::spawn(binary_path("drover"), full, log, log);
     ASSERT_TRUE(child.has_value()) << name;
     children_.push_back(Child{name, args, std::move(*child)});
@@ -121,19 +121,13 @@ class Fleet {
   }
   /// SIGTERM to everyone, newest first; each must exit 0.
   void stop() {
-    while (!children_.empty()) {
-      auto& child = children_.back();
-      child.process.signal(SIGTERM);
-      const auto status = child.process.wait_exit(30s);
-      EXPECT_TRUE(status.has_value()) << child.name << " did not stop on SIGTERM";
-      if (status) {
-        EXPECT_TRUE(status->exited && status->code == 0) << child.name << " ended with " << status->code;
-      }
-      if (::testing::Test::HasFailure()) {
-        std::cerr << "---- " << child.name << " ----\n" << read_file((dir_ / (child.name + ".log")).string());
-      }
-      children_.pop_back();
-    }
+    while (!children_.empty()) stop(std::prev(children_.end()));
+  }
+  /// SIGTERM to the agent started as `name`; it must exit 0.
+  void stop(const std::string& name) {
+    auto found = std::find_if(children_.begin(), children_.end(), [&](const Child& c) { return c.name == name; });
+    ASSERT_NE(found, children_.end()) << name;
+    stop(found);
   }
 
  private:
@@ -142,6 +136,20 @@ class Fleet {
     std::vector<std::string> args;
     ChildProcess process;
   };
+  void stop(std::list<Child>::iterator child) {
+    child->process.signal(SIGTERM);
+    const auto status = child->process.wait_exit(30s);
+    EXPECT_TRUE(status.has_value()) << child->name << " did not stop on SIGTERM";
+    if (status) {
+      EXPECT_TRUE(status->exited && status->code == 0) << child->name << " ended with " << status->code;
+    }
+    if (::testing::Test::HasFailure()) {
+      std::cerr << "---- " << child->name << " ----\n" << read_file((dir_ / (child->name + ".log")).string());
+      const auto restarted = dir_ / (child->name + ".restarted.log");
+      if (std::filesystem::exists(restarted)) std::cerr << "---- " << child->name << " restarted ----\n" << read_file(restarted.string());
+    }
+    children_.erase(child);
+  }
   std::uint32_t domain_;
   std::filesystem::path dir_;
   std::string topology_file_;
@@ -410,7 +418,7 @@ class FleetTest : public ::testing::Test {
 };
 
 TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
-  constexpr std::uint32_t kDomain = -14;
+  constexpr std::uint32_t kDomain = 86;
   Fleet fleet(kDomain, "crossing");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -455,7 +463,7 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
 }
 
 TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
-  constexpr std::uint32_t kDomain = -13;
+  constexpr std::uint32_t kDomain = 87;
   Fleet fleet(kDomain, "stall");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -521,7 +529,7 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
 }
 
 TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
-  constexpr std::uint32_t kDomain = -12;
+  constexpr std::uint32_t kDomain = 88;
   Fleet fleet(kDomain, "lock");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
@@ -563,7 +571,7 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
 }
 
 TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
-  constexpr std::uint32_t kDomain = -11;
+  constexpr std::uint32_t kDomain = 89;
   Fleet fleet(kDomain, "restart");
   fleet.start_infrastructure("topology.db");
   watch(kDomain, fleet, {"V1", "V2"});
@@ -597,7 +605,7 @@ TEST_F(FleetTest, OrdersSurviveCrashesOfTheTopologyAndRoutingAgents) {
 }
 
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
-  constexpr std::uint32_t kDomain = -10;
+  constexpr std::uint32_t kDomain = 90;
   Fleet fleet(kDomain, "drift");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
@@ -636,7 +644,7 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
 }
 
 TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
-  constexpr std::uint32_t kDomain = -9;
+  constexpr std::uint32_t kDomain = 91;
   Fleet fleet(kDomain, "park");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
@@ -657,7 +665,7 @@ TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
 }
 
 TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
-  constexpr std::uint32_t kDomain = -8;
+  constexpr std::uint32_t kDomain = 92;
   Fleet fleet(kDomain, "charge");
   // The H crossing with a charger at right-0.
   auto json = nlohmann::json::parse(std::ifstream(source_dir() + "/launch/topologies/h_crossing.json"));
@@ -689,7 +697,7 @@ TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
 }
 
 TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
-  constexpr std::uint32_t kDomain = -7;
+  constexpr std::uint32_t kDomain = 93;
   Fleet fleet(kDomain, "fatal");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
@@ -709,6 +717,23 @@ TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
   for (const auto* ahead : {"left-2", "bar-2", "right-4"}) {
     EXPECT_NE(seen_.holders[ahead], "V1") << "V1 still holds " << ahead;
   }
+}
+
+TEST_F(FleetTest, StoppedLogicalAgentStopsItsVehicleAndCancelsItsRouteAhead) {
+  constexpr std::uint32_t kDomain = 84;
+  Fleet fleet(kDomain, "shutdown");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-shutdown"));
+  fleet.stop("V1");
+  // The vehicle stood before the agent let go, and the reservations ahead are gone.
+  EXPECT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed == 0.0; }, 10s));
+  EXPECT_TRUE(seen_.wait(
+      [&] { return std::find(seen_.cancelled.begin(), seen_.cancelled.end(), "V1") != seen_.cancelled.end(); }, 30s))
+      << "V1's route was not cancelled on shutdown";
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_LT(seen_.latest["V1"].pose.y, 6.0) << "V1 drove on after its agent stopped";
+  for (const auto* ahead : {"bar-2", "right-4"}) EXPECT_NE(seen_.holders[ahead], "V1") << ahead;
 }
 
 }  // namespace
