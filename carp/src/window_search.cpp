@@ -26,7 +26,6 @@ void WindowSearch::begin(const SearchInput& input) {
     block_first_.resize(blocks, 0);
   }
   windows_.clear();
-  window_query_.start(input.agent, input.start_time, kForever, input.count_locks);
   states_.clear();
   open_.clear();
   sequence_ = 0;
@@ -38,7 +37,8 @@ std::uint32_t WindowSearch::windows_of(const SearchInput& input, EntityIndex ent
   if (entity_stamp_[entity] != generation_) {
     entity_stamp_[entity] = generation_;
     entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-    input.timelines->append_free_windows(entity, window_query_, windows_);
+    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
+                                         windows_, input.count_locks);
     entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
   }
   count = entity_count_[entity];

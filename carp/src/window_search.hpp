@@ -117,7 +117,6 @@ class WindowSearch {
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
   std::vector<std::uint32_t> block_stamp_, block_first_;
   std::vector<topology::Interval> windows_;
-  topology::FreeWindowQuery window_query_;  // what each timeline blocks, read once per search
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   std::uint32_t sequence_ = 0;
