@@ -26,29 +26,19 @@ bool same_agent(const std::string& a, std::string_view b) {
   return a.size() == b.size() && (b.empty() || a.back() == b.back()) && a == b;
 }
 
-/// Replaces out[base..] (blocked intervals within [from, until), in any order) by the
-/// windows between them: sorted, disjoint, maximal. The k-th window is written only after
-/// the k-th blocker has been read, so no scratch memory is needed.
-void complement_from(std::vector<Interval>& out, std::size_t base, TimeNs from, TimeNs until) {
-  std::sort(out.begin() + static_cast<std::ptrdiff_t>(base), out.end(),
-            [](const Interval& a, const Interval& b) { return a.start < b.start; });
-  const std::size_t blockers = out.size() - base;
-  std::size_t windows = 0;
-  TimeNs cursor = from;
-  for (std::size_t j = 0; j < blockers; ++j) {
-    const Interval blocker = out[base + j];
-    if (blocker.start > cursor) out[base + windows++] = Interval{cursor, blocker.start};
-    cursor = std::max(cursor, blocker.end);
-  }
-  if (cursor < until) {
-    if (windows < blockers) {
-      out[base + windows++] = Interval{cursor, until};
-    } else {
-      out.push_back(Interval{cursor, until});
-      ++windows;
-    }
-  }
-  out.resize(base + windows);
+/// Removes `cut` from the windows out[base..] (sorted, disjoint), splitting one if needed.
+void cut_from(std::vector<Interval>& out, std::size_t base, Interval cut) {
+  const auto begin = out.begin() + static_cast<std::ptrdiff_t>(base);
+  const auto first =
+      std::partition_point(begin, out.end(), [&](const Interval& w) { return w.end <= cut.start; });
+  const auto last =
+      std::partition_point(first, out.end(), [&](const Interval& w) { return w.start < cut.end; });
+  if (first == last) return;
+  const Interval left{first->start, cut.start};
+  const Interval right{cut.end, (last - 1)->end};
+  auto at = out.erase(first, last);
+  if (right.valid()) at = out.insert(at, right);
+  if (left.valid()) out.insert(at, left);
 }
 
 }  // namespace
@@ -57,29 +47,31 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
                                       TimeNs until, std::vector<Interval>& out,
                                       bool count_locks) const {
   if (!owns(entity) || from >= until) return;
-  // The blockers are collected at the end of `out` itself and turned into their complement.
+  // One sweep over the reservations, which are sorted by start: a window ends where the
+  // next blocker starts. Then the locks, rare, are cut out.
   const std::size_t base = out.size();
-  const auto block = [&](TimeNs start, TimeNs end) {
-    const Interval w{std::max(start, from), std::min(end, until)};
-    if (w.valid()) out.push_back(w);
-  };
+  TimeNs cursor = from;  // the end of everything blocked so far
   for (const Reservation& r : timelines_[entity].reservations) {
     if (same_agent(r.agent, agent)) continue;
     // Most reservations' origins are not held at all: that is checked first, inline.
-    const bool held = r.window.start > from && r.origin < held_.size() && held_[r.origin] &&
-                      Impl::is_held(*this, r);
-    block(held ? from : r.window.start, r.window.end);
+    if (r.window.start > from && r.origin < held_.size() && held_[r.origin] &&
+        Impl::is_held(*this, r)) {
+      out.resize(base);  // nobody may come before a holder
+    } else if (r.window.start > cursor && cursor < until) {
+      out.push_back(Interval{cursor, std::min(r.window.start, until)});
+    }
+    cursor = std::max(cursor, r.window.end);
   }
+  if (cursor < until) out.push_back(Interval{cursor, until});
   if (count_locks) {
-    const auto block_locks = [&](EntityIndex x) {
-      for (const Lock& lock : timelines_[x].locks) block(lock.window.start, lock.window.end);
+    const auto cut_locks = [&](EntityIndex x) {
+      for (const Lock& lock : timelines_[x].locks) cut_from(out, base, lock.window);
     };
-    block_locks(entity);
+    cut_locks(entity);
     for (EntityIndex f : conflict_sets_[entity]) {
-      if (owns(f)) block_locks(f);
+      if (owns(f)) cut_locks(f);
     }
   }
-  complement_from(out, base, from, until);
 }
 
 }  // namespace drover::topology
