@@ -82,9 +82,9 @@ TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
 }
 
 WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estimate,
-                                                 std::uint32_t state, std::uint32_t arc) {
+                                                 std::uint32_t state) {
   return OpenEntry{std::max(ready + estimate, arrival_floor_), estimate, ready, sequence_++,
-                   state, arc};
+                   state};
 }
 
 void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
@@ -100,7 +100,7 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
   s.parent = parent;
   s.arc = arc;
   s.edge_entry = edge_entry;
-  open_.push(open_entry(ready, estimate, state, kNone));
+  open_.push(open_entry(ready, estimate, state));
 }
 
 void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
@@ -168,10 +168,6 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
-    if (top.arc != kNone) {  // a deferred move: now look at the windows
-      drive(input, top.state, top.arc, top.h, outcome);
-      continue;
-    }
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
     popped.closed = true;
@@ -206,18 +202,10 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
               kNone, 0, next_estimate);
     }
   }
-  // Moves along the arcs are deferred, keyed by the earliest arrival they could give.
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
     if (!traversal.usable_arc(a)) continue;
-    if (current.ready + traversal.clearance(a) > window_end) continue;
     const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
-    if (arc_estimate == kUnreachable) continue;
-    const TimeNs earliest = current.ready + traversal.travel(a);
-    if (earliest > input.deadline) {
-      outcome.horizon_cut = true;
-      continue;
-    }
-    open_.push(open_entry(earliest, arc_estimate, index, a));
+    if (arc_estimate != kUnreachable) drive(input, index, a, arc_estimate, outcome);
   }
 }
 

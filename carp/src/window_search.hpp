@@ -69,16 +69,13 @@ class WindowSearch {
     std::uint16_t layer;
     bool closed;
   };
-  /// An open state, or (arc != kNone) a deferred move from a closed state along an arc,
-  /// keyed by the earliest the move could arrive: the windows of the arc's edge and
-  /// destination are looked up only if the search ever gets that far.
+  /// An open state, keyed by a lower bound of the arrival through it.
   struct OpenEntry {
-    TimeNs f;                // max(ready + h, arrival_floor_): a lower bound of the arrival
+    TimeNs f;                // max(ready + h, arrival_floor_)
     DurationNs h;            // the heuristic: reservation-free time still to go
-    TimeNs ready;
+    TimeNs ready;            // the state's ready when pushed (a later push supersedes it)
     std::uint32_t sequence;  // push order
     std::uint32_t state;
-    std::uint32_t arc;
     /// Ties go to the entry closer to the goal (smaller h: without the floor, the later
     /// state), then to the newest: on grids many paths are equally fast, and going deep
     /// along one spares exploring all of them.
@@ -94,8 +91,8 @@ class WindowSearch {
   /// The earliest the last stop can be reached and held (its first free window long
   /// enough for the hold, or open-ended), from its free windows; input.start_time if none.
   TimeNs arrival_floor(const SearchInput& input);
-  /// The open-list key of a state or move that could leave at `ready`, `estimate` to go.
-  OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state, std::uint32_t arc);
+  /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
+  OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
                            std::uint32_t& count);
