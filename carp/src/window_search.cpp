@@ -104,7 +104,7 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
 }
 
 void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
-                         DurationNs estimate, SearchOutcome& outcome) {
+                         SearchOutcome& outcome) {
   const Arc& a = input.graph->arc(arc);
   const DurationNs travel = input.traversal->travel(arc);
   const DurationNs clearance = input.traversal->clearance(arc);
@@ -123,6 +123,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex 
         begin);
   };
   std::uint32_t block = kNone;
+  DurationNs to_go = -1;  // the heuristic of a.to, looked up only if a state improves
   for (std::uint32_t i = later_than(edge_first, edge_count, current.ready); i < edge_count; ++i) {
     const Interval edge = windows_[edge_first + i];
     if (edge.start > latest_onto_edge) break;
@@ -140,7 +141,10 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex 
         break;  // later windows are later still
       }
       if (block == kNone) block = states_of(input, current.layer, a.to);
-      improve(block + j, arrival, arrival, from, arc, onto_edge, estimate);
+      if (arrival >= states_[block + j].ready) continue;
+      if (to_go < 0) to_go = estimate(input, current.layer, a.to);
+      if (to_go == kUnreachable) return;
+      improve(block + j, arrival, arrival, from, arc, onto_edge, to_go);
     }
   }
 }
@@ -203,9 +207,7 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
     }
   }
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-    if (!traversal.usable_arc(a)) continue;
-    const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
-    if (arc_estimate != kUnreachable) drive(input, index, a, arc_estimate, outcome);
+    if (traversal.usable_arc(a)) drive(input, index, a, outcome);
   }
 }
 
