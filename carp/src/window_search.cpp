@@ -103,12 +103,11 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
   open_.push(open_entry(ready, estimate, state));
 }
 
-void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
-                         SearchOutcome& outcome) {
+void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
+                         ArcIndex arc, SearchOutcome& outcome) {
   const Arc& a = input.graph->arc(arc);
   const DurationNs travel = input.traversal->travel(arc);
   const DurationNs clearance = input.traversal->clearance(arc);
-  const State current = states_[from];
   // The vehicle must be off the vertex, tail included, before its window ends.
   const TimeNs latest_onto_edge = windows_[current.window].end - clearance;
   if (current.ready > latest_onto_edge) return;
@@ -207,7 +206,7 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
     }
   }
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-    if (traversal.usable_arc(a)) drive(input, index, a, outcome);
+    if (traversal.usable_arc(a)) drive(input, index, current, a, outcome);
   }
 }
 

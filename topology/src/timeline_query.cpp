@@ -69,7 +69,7 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
     };
     cut_locks(entity);
     for (EntityIndex f : conflict_sets_[entity]) {
-      if (owns(f)) cut_locks(f);
+      if (!timelines_[f].locks.empty() && owns(f)) cut_locks(f);
     }
   }
 }
