@@ -68,17 +68,50 @@ DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
   return to_stop == kUnreachable ? kUnreachable : to_stop + leg.tail;
 }
 
+TimeNs WindowSearch::held_from(const SearchInput& input, Interval window, TimeNs at) {
+  const DurationNs hold = input.legs.back().dwell;
+  at = std::max(at, window.start);
+  const bool holds = hold == kForever ? window.end == kForever : at + hold <= window.end;
+  return holds ? at : kForever;
+}
+
 TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
   const Leg& last = input.legs.back();
-  std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, last.stop, count);
-  for (std::uint32_t i = 0; i < count; ++i) {
-    const Interval w = windows_[first + i];
-    if (last.dwell == kForever ? w.end == kForever : w.end - w.start >= last.dwell) {
-      return w.start;
+  const EntityIndex previous =
+      input.legs.size() > 1 ? input.legs[input.legs.size() - 2].stop : input.start;
+  TimeNs floor = kForever;
+  if (previous == last.stop) {  // the last leg may start on the stop: no arc needed
+    floor = held_after(input, input.start_time);
+  } else {
+    for (const ArcIndex a : input.graph->arcs_into(last.stop)) {
+      if (input.traversal->usable_arc(a)) floor = std::min(floor, arrival_over(input, a, floor));
     }
   }
-  return input.start_time;
+  return floor == kForever ? input.start_time : floor;
+}
+
+TimeNs WindowSearch::held_after(const SearchInput& input, TimeNs at) {
+  std::uint32_t count = 0;
+  const std::uint32_t first = windows_of(input, input.legs.back().stop, count);
+  for (std::uint32_t g = 0; g < count; ++g) {
+    if (const TimeNs t = held_from(input, windows_[first + g], at); t != kForever) return t;
+  }
+  return kForever;
+}
+
+TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound) {
+  // Inside a free window e of the arc's edge, the vehicle arrives at z >= e.start + travel
+  // and its tail leaves the edge by z + clearance <= e.end.
+  const DurationNs travel = input.traversal->travel(arc);
+  const DurationNs clearance = input.traversal->clearance(arc);
+  std::uint32_t count = 0;
+  const std::uint32_t first = windows_of(input, input.graph->arc(arc).edge, count);
+  for (std::uint32_t e = 0; e < count && windows_[first + e].start + travel < bound; ++e) {
+    const Interval edge = windows_[first + e];
+    const TimeNs z = held_after(input, edge.start + travel);
+    if (z != kForever && z + clearance <= edge.end) return z;
+  }
+  return kForever;
 }
 
 WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estimate,

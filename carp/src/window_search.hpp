@@ -88,9 +88,20 @@ class WindowSearch {
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
   void begin(const SearchInput& input);
-  /// The earliest the last stop can be reached and held (its first free window long
-  /// enough for the hold, or open-ended), from its free windows; input.start_time if none.
+  /// A lower bound of the arrival: the earliest the last stop can be entered and held (in
+  /// a free window long enough for the hold, or open-ended), looking one step back: unless
+  /// the last leg starts on the stop, the vehicle drives in along an arc whose edge must be
+  /// free from `travel` before to `clearance` after (such edges often stay blocked a little
+  /// longer than the stop, by the same passing vehicle). input.start_time if none.
   TimeNs arrival_floor(const SearchInput& input);
+  /// The earliest time >= `at` from which the last stop can be held, kForever if none.
+  TimeNs held_after(const SearchInput& input, TimeNs at);
+  /// The earliest time >= `at` from which `window` (of the last stop) can hold the
+  /// vehicle, kForever if it cannot.
+  static TimeNs held_from(const SearchInput& input, topology::Interval window, TimeNs at);
+  /// The earliest arrival at the last stop along `arc` that its edge's windows allow, if
+  /// before `bound`; kForever otherwise.
+  TimeNs arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound);
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
