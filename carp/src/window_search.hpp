@@ -1,8 +1,8 @@
 #pragma once
 // The CARP search: A* over (stop layer, vertex, free window) states, ordered by the earliest
 // time the vehicle can leave the vertex plus the exact reservation-free time still to go, or
-// by the earliest time the last stop can be held if that is later (both are lower bounds
-// of the arrival).
+// by the arrival floor (the earliest the vehicle can drive into the last stop and hold it)
+// if that is later (both are lower bounds of the arrival).
 //
 // A state (k, v, w) means: heading for stop k, the vehicle is on vertex v inside its free
 // window w, entered at `entry` and able to leave from `ready` on (entry, or entry + the
