@@ -32,17 +32,12 @@ void WindowSearch::begin(const SearchInput& input) {
   goal_state_ = kNone;
 }
 
-std::uint32_t WindowSearch::windows_of(const SearchInput& input, EntityIndex entity,
-                                       std::uint32_t& count) {
-  if (entity_stamp_[entity] != generation_) {
-    entity_stamp_[entity] = generation_;
-    entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
-                                         windows_, input.count_locks);
-    entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
-  }
-  count = entity_count_[entity];
-  return entity_first_[entity];
+void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
+  entity_stamp_[entity] = generation_;
+  entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
+  input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever, windows_,
+                                       input.count_locks);
+  entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
 std::uint32_t WindowSearch::states_of(const SearchInput& input, std::uint32_t layer,

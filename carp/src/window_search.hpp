@@ -105,8 +105,15 @@ class WindowSearch {
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
+  /// Inline: most calls find them read already.
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
-                           std::uint32_t& count);
+                           std::uint32_t& count) {
+    if (entity_stamp_[entity] != generation_) read_windows(input, entity);
+    count = entity_count_[entity];
+    return entity_first_[entity];
+  }
+  /// Appends the free windows of `entity` to windows_ and records where they are.
+  void read_windows(const SearchInput& input, topology::EntityIndex entity);
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex);
