@@ -40,20 +40,16 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
-std::uint32_t WindowSearch::states_of(const SearchInput& input, std::uint32_t layer,
-                                      EntityIndex vertex) {
-  const std::size_t key = layer * input.graph->vertex_count() + vertex;
-  if (block_stamp_[key] != generation_) {
-    block_stamp_[key] = generation_;
-    std::uint32_t count = 0;
-    const std::uint32_t first_window = windows_of(input, vertex, count);
-    block_first_[key] = static_cast<std::uint32_t>(states_.size());
-    for (std::uint32_t i = 0; i < count; ++i) {
-      states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
-                              static_cast<std::uint16_t>(layer), false});
-    }
+void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
+                              EntityIndex vertex) {
+  block_stamp_[key] = generation_;
+  std::uint32_t count = 0;
+  const std::uint32_t first_window = windows_of(input, vertex, count);
+  block_first_[key] = static_cast<std::uint32_t>(states_.size());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
+                            static_cast<std::uint16_t>(layer), false});
   }
-  return block_first_[key];
 }
 
 DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,

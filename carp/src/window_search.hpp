@@ -116,7 +116,14 @@ class WindowSearch {
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
-                          topology::EntityIndex vertex);
+                          topology::EntityIndex vertex) {
+    const std::size_t key = layer * input.graph->vertex_count() + vertex;
+    if (block_stamp_[key] != generation_) add_states(input, key, layer, vertex);
+    return block_first_[key];
+  }
+  /// Adds the (unreached) states of (layer, vertex), one per window, under `key`.
+  void add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
+                  topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
   /// Drives arc `arc` from state `from` (`current`, a copy: states_ may grow) into every
