@@ -26,39 +26,30 @@ void WindowSearch::begin(const SearchInput& input) {
     block_first_.resize(blocks, 0);
   }
   windows_.clear();
-  window_query_.start(input.agent, input.start_time, kForever, input.count_locks);
   states_.clear();
   open_.clear();
   sequence_ = 0;
   goal_state_ = kNone;
 }
 
-std::uint32_t WindowSearch::windows_of(const SearchInput& input, EntityIndex entity,
-                                       std::uint32_t& count) {
-  if (entity_stamp_[entity] != generation_) {
-    entity_stamp_[entity] = generation_;
-    entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-    input.timelines->append_free_windows(entity, window_query_, windows_);
-    entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
-  }
-  count = entity_count_[entity];
-  return entity_first_[entity];
+void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
+  entity_stamp_[entity] = generation_;
+  entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
+  input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever, windows_,
+                                       input.count_locks);
+  entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
-std::uint32_t WindowSearch::states_of(const SearchInput& input, std::uint32_t layer,
-                                      EntityIndex vertex) {
-  const std::size_t key = layer * input.graph->vertex_count() + vertex;
-  if (block_stamp_[key] != generation_) {
-    block_stamp_[key] = generation_;
-    std::uint32_t count = 0;
-    const std::uint32_t first_window = windows_of(input, vertex, count);
-    block_first_[key] = static_cast<std::uint32_t>(states_.size());
-    for (std::uint32_t i = 0; i < count; ++i) {
-      states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
-                              static_cast<std::uint16_t>(layer), false});
-    }
+void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
+                              EntityIndex vertex) {
+  block_stamp_[key] = generation_;
+  std::uint32_t count = 0;
+  const std::uint32_t first_window = windows_of(input, vertex, count);
+  block_first_[key] = static_cast<std::uint32_t>(states_.size());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
+                            static_cast<std::uint16_t>(layer), false});
   }
-  return block_first_[key];
 }
 
 DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
@@ -68,23 +59,56 @@ DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
   return to_stop == kUnreachable ? kUnreachable : to_stop + leg.tail;
 }
 
+TimeNs WindowSearch::held_from(const SearchInput& input, Interval window, TimeNs at) {
+  const DurationNs hold = input.legs.back().dwell;
+  at = std::max(at, window.start);
+  const bool holds = hold == kForever ? window.end == kForever : at + hold <= window.end;
+  return holds ? at : kForever;
+}
+
 TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
   const Leg& last = input.legs.back();
-  std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, last.stop, count);
-  for (std::uint32_t i = 0; i < count; ++i) {
-    const Interval w = windows_[first + i];
-    if (last.dwell == kForever ? w.end == kForever : w.end - w.start >= last.dwell) {
-      return w.start;
+  const EntityIndex previous =
+      input.legs.size() > 1 ? input.legs[input.legs.size() - 2].stop : input.start;
+  TimeNs floor = kForever;
+  if (previous == last.stop) {  // the last leg may start on the stop: no arc needed
+    floor = held_after(input, input.start_time);
+  } else {
+    for (const ArcIndex a : input.graph->arcs_into(last.stop)) {
+      if (input.traversal->usable_arc(a)) floor = std::min(floor, arrival_over(input, a, floor));
     }
   }
-  return input.start_time;
+  return floor == kForever ? input.start_time : floor;
+}
+
+TimeNs WindowSearch::held_after(const SearchInput& input, TimeNs at) {
+  std::uint32_t count = 0;
+  const std::uint32_t first = windows_of(input, input.legs.back().stop, count);
+  for (std::uint32_t g = 0; g < count; ++g) {
+    if (const TimeNs t = held_from(input, windows_[first + g], at); t != kForever) return t;
+  }
+  return kForever;
+}
+
+TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound) {
+  // Inside a free window e of the arc's edge, the vehicle arrives at z >= e.start + travel
+  // and its tail leaves the edge by z + clearance <= e.end.
+  const DurationNs travel = input.traversal->travel(arc);
+  const DurationNs clearance = input.traversal->clearance(arc);
+  std::uint32_t count = 0;
+  const std::uint32_t first = windows_of(input, input.graph->arc(arc).edge, count);
+  for (std::uint32_t e = 0; e < count && windows_[first + e].start + travel < bound; ++e) {
+    const Interval edge = windows_[first + e];
+    const TimeNs z = held_after(input, edge.start + travel);
+    if (z != kForever && z + clearance <= edge.end) return z;
+  }
+  return kForever;
 }
 
 WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estimate,
-                                                 std::uint32_t state, std::uint32_t arc) {
+                                                 std::uint32_t state) {
   return OpenEntry{std::max(ready + estimate, arrival_floor_), estimate, ready, sequence_++,
-                   state, arc};
+                   state};
 }
 
 void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
@@ -100,15 +124,14 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
   s.parent = parent;
   s.arc = arc;
   s.edge_entry = edge_entry;
-  open_.push(open_entry(ready, estimate, state, kNone));
+  open_.push(open_entry(ready, estimate, state));
 }
 
-void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex arc,
-                         DurationNs estimate, SearchOutcome& outcome) {
+void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
+                         ArcIndex arc, SearchOutcome& outcome) {
   const Arc& a = input.graph->arc(arc);
   const DurationNs travel = input.traversal->travel(arc);
   const DurationNs clearance = input.traversal->clearance(arc);
-  const State current = states_[from];
   // The vehicle must be off the vertex, tail included, before its window ends.
   const TimeNs latest_onto_edge = windows_[current.window].end - clearance;
   if (current.ready > latest_onto_edge) return;
@@ -123,6 +146,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex 
         begin);
   };
   std::uint32_t block = kNone;
+  DurationNs to_go = -1;  // the heuristic of a.to, looked up only if a state improves
   for (std::uint32_t i = later_than(edge_first, edge_count, current.ready); i < edge_count; ++i) {
     const Interval edge = windows_[edge_first + i];
     if (edge.start > latest_onto_edge) break;
@@ -140,7 +164,10 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, ArcIndex 
         break;  // later windows are later still
       }
       if (block == kNone) block = states_of(input, current.layer, a.to);
-      improve(block + j, arrival, arrival, from, arc, onto_edge, estimate);
+      if (arrival >= states_[block + j].ready) continue;
+      if (to_go < 0) to_go = estimate(input, current.layer, a.to);
+      if (to_go == kUnreachable) return;
+      improve(block + j, arrival, arrival, from, arc, onto_edge, to_go);
     }
   }
 }
@@ -168,10 +195,6 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
-    if (top.arc != kNone) {  // a deferred move: now look at the windows
-      drive(input, top.state, top.arc, top.h, outcome);
-      continue;
-    }
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
     popped.closed = true;
@@ -206,18 +229,8 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
               kNone, 0, next_estimate);
     }
   }
-  // Moves along the arcs are deferred, keyed by the earliest arrival they could give.
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-    if (!traversal.usable_arc(a)) continue;
-    if (current.ready + traversal.clearance(a) > window_end) continue;
-    const DurationNs arc_estimate = estimate(input, current.layer, graph.arc(a).to);
-    if (arc_estimate == kUnreachable) continue;
-    const TimeNs earliest = current.ready + traversal.travel(a);
-    if (earliest > input.deadline) {
-      outcome.horizon_cut = true;
-      continue;
-    }
-    open_.push(open_entry(earliest, arc_estimate, index, a));
+    if (traversal.usable_arc(a)) drive(input, index, current, a, outcome);
   }
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // The CARP search: A* over (stop layer, vertex, free window) states, ordered by the earliest
 // time the vehicle can leave the vertex plus the exact reservation-free time still to go, or
-// by the earliest time the last stop can be held if that is later (both are lower bounds
-// of the arrival).
+// by the arrival floor (the earliest the vehicle can drive into the last stop and hold it)
+// if that is later (both are lower bounds of the arrival).
 //
 // A state (k, v, w) means: heading for stop k, the vehicle is on vertex v inside its free
 // window w, entered at `entry` and able to leave from `ready` on (entry, or entry + the
@@ -69,16 +69,13 @@ class WindowSearch {
     std::uint16_t layer;
     bool closed;
   };
-  /// An open state, or (arc != kNone) a deferred move from a closed state along an arc,
-  /// keyed by the earliest the move could arrive: the windows of the arc's edge and
-  /// destination are looked up only if the search ever gets that far.
+  /// An open state, keyed by a lower bound of the arrival through it.
   struct OpenEntry {
-    TimeNs f;                // max(ready + h, arrival_floor_): a lower bound of the arrival
+    TimeNs f;                // max(ready + h, arrival_floor_)
     DurationNs h;            // the heuristic: reservation-free time still to go
-    TimeNs ready;
+    TimeNs ready;            // the state's ready when pushed (a later push supersedes it)
     std::uint32_t sequence;  // push order
     std::uint32_t state;
-    std::uint32_t arc;
     /// Ties go to the entry closer to the goal (smaller h: without the floor, the later
     /// state), then to the newest: on grids many paths are equally fast, and going deep
     /// along one spares exploring all of them.
@@ -91,21 +88,47 @@ class WindowSearch {
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
   void begin(const SearchInput& input);
-  /// The earliest the last stop can be reached and held (its first free window long
-  /// enough for the hold, or open-ended), from its free windows; input.start_time if none.
+  /// A lower bound of the arrival: the earliest the last stop can be entered and held (in
+  /// a free window long enough for the hold, or open-ended), looking one step back: unless
+  /// the last leg starts on the stop, the vehicle drives in along an arc whose edge must be
+  /// free from `travel` before to `clearance` after (such edges often stay blocked a little
+  /// longer than the stop, by the same passing vehicle). input.start_time if none.
   TimeNs arrival_floor(const SearchInput& input);
-  /// The open-list key of a state or move that could leave at `ready`, `estimate` to go.
-  OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state, std::uint32_t arc);
+  /// The earliest time >= `at` from which the last stop can be held, kForever if none.
+  TimeNs held_after(const SearchInput& input, TimeNs at);
+  /// The earliest time >= `at` from which `window` (of the last stop) can hold the
+  /// vehicle, kForever if it cannot.
+  static TimeNs held_from(const SearchInput& input, topology::Interval window, TimeNs at);
+  /// The earliest arrival at the last stop along `arc` that its edge's windows allow, if
+  /// before `bound`; kForever otherwise.
+  TimeNs arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound);
+  /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
+  OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
+  /// Inline: most calls find them read already.
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
-                           std::uint32_t& count);
+                           std::uint32_t& count) {
+    if (entity_stamp_[entity] != generation_) read_windows(input, entity);
+    count = entity_count_[entity];
+    return entity_first_[entity];
+  }
+  /// Appends the free windows of `entity` to windows_ and records where they are.
+  void read_windows(const SearchInput& input, topology::EntityIndex entity);
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
-                          topology::EntityIndex vertex);
+                          topology::EntityIndex vertex) {
+    const std::size_t key = layer * input.graph->vertex_count() + vertex;
+    if (block_stamp_[key] != generation_) add_states(input, key, layer, vertex);
+    return block_first_[key];
+  }
+  /// Adds the (unreached) states of (layer, vertex), one per window, under `key`.
+  void add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
+                  topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
-  /// Drives arc `arc` from state `from` into every window of its destination it can reach.
-  void drive(const SearchInput& input, std::uint32_t from, ArcIndex arc, DurationNs estimate,
+  /// Drives arc `arc` from state `from` (`current`, a copy: states_ may grow) into every
+  /// window of its destination it can reach.
+  void drive(const SearchInput& input, std::uint32_t from, const State& current, ArcIndex arc,
              SearchOutcome& outcome);
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
                std::uint32_t arc, TimeNs edge_entry, DurationNs estimate);
@@ -117,7 +140,6 @@ class WindowSearch {
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
   std::vector<std::uint32_t> block_stamp_, block_first_;
   std::vector<topology::Interval> windows_;
-  topology::FreeWindowQuery window_query_;  // what each timeline blocks, read once per search
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   std::uint32_t sequence_ = 0;

@@ -66,6 +66,19 @@ TEST(Planner, WaitsUntilAnotherAgentsReservationIsOver) {
   EXPECT_EQ(route.arrival, sec(8));
 }
 
+TEST(Planner, ArrivesOneMoveAfterTheGoalIsFreeWhenTheEdgesInAreBlockedAsLong) {
+  // The goal is free from 5 s on, and so is the edge into it (which conflicts with it):
+  // the arrival floor looks one step back and starts the search at 6 s, the true arrival.
+  World w(GridBuilder().corridor(3).build());
+  w.occupy("b", "2,0", sec(0), sec(5));
+  const Route route = plan_ok(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+  EXPECT_EQ(route.arrival, sec(6));
+  // A last leg that starts on its stop needs no arc: arriving there at the start time.
+  w.occupy("c", "0,0", sec(0), sec(1));
+  const Route stay = plan_ok(w, request_to(w, "a", "1,0", {open_stop(w, "1,0")}));
+  EXPECT_EQ(stay.arrival, sec(0));
+}
+
 TEST(Planner, TheAgentsOwnReservationsNeverBlockIt) {
   World w(GridBuilder().corridor(5).build());
   w.occupy("a", "2,0", sec(0), sec(50));

@@ -36,23 +36,6 @@ struct TimelineSet::Impl {
                                   const std::function<bool(const Reservation&)>& doomed,
                                   TouchedSet& touched);
 
-  /// What a free-window query asks: blockers of a step of `agent` on `entity`, within
-  /// [from, until), with or without locks.
-  struct BlockRule {
-    std::string_view agent;
-    EntityIndex entity = kNoEntity;
-    TimeNs from = 0;
-    TimeNs until = 0;
-    bool count_locks = true;
-  };
-  /// Appends to `out` what keeps the rule's step from writing on timeline x (x is the
-  /// step's entity or a member of its conflict set), clipped to [from, until), in no
-  /// particular order: the free-window rule. With `shadows` given, x's locks and real
-  /// reservations go to `out` and every other agent's shadow on x to `shadows` with its
-  /// origin, unfiltered (the caller filters them per step entity).
-  static void append_blocked(const TimelineSet& set, EntityIndex x, const BlockRule& rule,
-                             std::vector<Interval>& out, std::vector<ShadowBlock>* shadows);
-
   /// Every check of prepare (see its contract), for `op` ("prepare" or "reserve").
   static Status admit(const TimelineSet& set, const std::vector<Reservation>& items,
                       const std::vector<ExpectedVersion>& expected, const std::string& op);

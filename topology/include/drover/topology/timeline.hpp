@@ -187,36 +187,6 @@ struct TimelineSnapshot {
   friend bool operator==(const TimelineSnapshot&, const TimelineSnapshot&) = default;
 };
 
-/// A shadow reservation as a free-window query sees it: when it blocks, and which entity it
-/// stands for (it blocks only steps on entities that conflict with that one).
-struct ShadowBlock {
-  Interval window;
-  EntityIndex origin = kNoEntity;
-};
-
-/// Memory for many free-window queries of one agent on one TimelineSet that does not change
-/// meanwhile (a planner's search): what blocks the agent on each timeline is read once and
-/// reused for every entity whose windows depend on it. See
-/// TimelineSet::append_free_windows(entity, query, out). Implemented in timeline_query.cpp.
-class FreeWindowQuery {
- public:
-  /// Starts a new series of queries for `agent` over [from, until), counting locks or not.
-  /// Forgets what was read before (the set may have changed since).
-  void start(std::string_view agent, TimeNs from, TimeNs until, bool count_locks = true);
-
- private:
-  friend class TimelineSet;
-  std::string agent_;
-  TimeNs from_ = 0;
-  TimeNs until_ = 0;
-  bool count_locks_ = true;
-  std::uint32_t generation_ = 0;
-  std::vector<std::uint32_t> stamp_, first_, count_;  // per timeline, into blocked_
-  std::vector<Interval> blocked_;  // locks and real reservations: sorted, disjoint, per timeline
-  std::vector<std::uint32_t> shadow_first_, shadow_count_;  // per timeline, into shadows_
-  std::vector<ShadowBlock> shadows_;  // other agents' shadows, per timeline
-};
-
 /// The timelines of a set of entities (all of a topology, or one partition's).
 class TimelineSet {
  public:
@@ -245,15 +215,14 @@ class TimelineSet {
                                   const std::vector<RouteStep>& steps) const;
 
   /// Windows within [from, until) in which `agent` could occupy `entity`: free of other
-  /// agents' reservations on its timeline and of locks on it and on C(entity). Sorted,
-  /// disjoint, maximal. The agent's own reservations never block it.
-  /// As a step on `entity` also writes shadows on C(entity), other agents' reservations
-  /// on the owned members of C(entity) block too when their origin conflicts with
-  /// `entity` (real ones always; shadows of `entity` or of a member of C(entity)), and so
-  /// does everything up to the end of such a reservation that is allocated (nobody may
-  /// come before a holder): a
-  /// step whose window lies in one of these windows is accepted by prepare (versions
-  /// aside), as far as the owned entities go. Empty for an entity not owned.
+  /// agents' reservations on its timeline, of everything up to the end of such a
+  /// reservation that is allocated (nobody may come before a holder), and of locks on the
+  /// entity and on the owned members of C(entity). Sorted, disjoint, maximal. The agent's
+  /// own reservations never block it. A step whose window lies in one of these windows is
+  /// accepted by prepare (versions aside), as far as the owned entities go, provided every
+  /// route on the timelines was written as expand() splits it (so a reservation on a
+  /// member of C(entity) whose origin conflicts with `entity` has its twin, real or
+  /// shadow, on the entity's own timeline). Empty for an entity not owned.
   std::vector<Interval> free_windows(EntityIndex entity, const AgentId& agent, TimeNs from,
                                      TimeNs until) const;
 
@@ -265,11 +234,6 @@ class TimelineSet {
   void append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                            TimeNs until, std::vector<Interval>& out,
                            bool count_locks = true) const;
-  /// The same windows for the query's agent, interval and locks setting, reading each
-  /// timeline only once per query series. \pre the set has not changed since query.start.
-  void append_free_windows(EntityIndex entity, FreeWindowQuery& query,
-                           std::vector<Interval>& out) const;
-
   /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
   /// overlaps a lock or another agent's reservation whose origin conflicts with the
   /// item's (I1), or if an expected version moved;
