@@ -111,7 +111,17 @@ RouteModel::RouteModel(std::shared_ptr<const topology::Topology> topology,
     : topology_(std::move(topology)),
       graph_(std::move(graph)),
       planner_(graph_, options),
-      timelines_(std::move(conflict_sets)) {}
+      timelines_(std::move(conflict_sets)),
+      planning_(timelines_) {}
+
+const topology::TimelineSet& RouteModel::planning_timelines() {
+  if (planning_stale_) {
+    planning_ = timelines_;
+    planning_.widen_to_step_hulls();
+    planning_stale_ = false;
+  }
+  return planning_;
+}
 
 bool RouteModel::apply(const msg::TimelineState& state) {
   const auto entity = topology_->find(state.entity());
@@ -140,6 +150,7 @@ bool RouteModel::apply(const msg::TimelineState& state) {
   }
   if (!state.holder().empty()) timeline.holder = state.holder();
   timeline.waiting = state.waiting();
+  planning_stale_ = true;
   return static_cast<bool>(timelines_.replace_timeline(*entity, std::move(timeline)));
 }
 

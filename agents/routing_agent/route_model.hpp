@@ -35,7 +35,11 @@ class RouteModel {
   bool apply(const msg::TimelineState& state);
 
   const topology::Topology& topology() const noexcept { return *topology_; }
+  /// The replica as published: versions for prepares.
   topology::TimelineSet& timelines() noexcept { return timelines_; }
+  /// What routes are planned on: the replica with every route step's copies widened to
+  /// their hull (TimelineSet::widen_to_step_hulls), rebuilt after apply() changed it.
+  const topology::TimelineSet& planning_timelines();
   carp::Planner& planner() noexcept { return planner_; }
   /// The partition that owns `entity`. \pre entity < topology().entity_count()
   const std::string& partition(topology::EntityIndex entity) const { return topology_->partition(entity); }
@@ -49,6 +53,8 @@ class RouteModel {
   std::shared_ptr<const carp::RoutingGraph> graph_;
   carp::Planner planner_;
   topology::TimelineSet timelines_;
+  topology::TimelineSet planning_;
+  bool planning_stale_ = true;
 };
 
 }  // namespace drover::routing_agent

@@ -127,6 +127,7 @@ void RoutingAgent::on_route(const msg::RouteRequest& request, dds::ReplyHandle<m
                  served.error().error.message);
     out.error(dds::to_wire(served.error().error));
     out.failure(served.error().failure);
+    out.blockers(served.error().blockers);
     out.route(request.route());
   }
   if (auto sent = reply.send(std::move(out)); !sent) {
@@ -170,6 +171,10 @@ Result<carp::PlanRequest, RoutingAgent::RouteError> RoutingAgent::prepare_model(
   return std::move(*plan);
 }
 
+RoutingAgent::RouteError RoutingAgent::plan_failure(const carp::PlanError& error) {
+  return RouteError{carp::to_error(error), carp::to_string(error.reason), error.blockers};
+}
+
 Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve(const msg::RouteRequest& request) {
   if (request.real() && request.agent().empty()) {
     return unexpected(RouteError{Error{ErrorCode::invalid_argument, "agent: a real route needs the agent it is for"},
@@ -182,8 +187,8 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve(const msg:
     lock.unlock();
     return serve_real(request, std::move(*plan));
   }
-  auto route = model_->planner().plan(model_->timelines(), *plan);
-  if (!route) return unexpected(RouteError{carp::to_error(route.error()), carp::to_string(route.error().reason)});
+  auto route = model_->planner().plan(model_->planning_timelines(), *plan);
+  if (!route) return unexpected(plan_failure(route.error()));
   msg::RouteReply reply;
   reply.route(request.route());
   reply.attempts(1);
@@ -257,9 +262,9 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
         if (!replanned) return unexpected(replanned.error());
         plan = std::move(*replanned);
       }
-      auto planned = model_->planner().plan(model_->timelines(), plan);
+      auto planned = model_->planner().plan(model_->planning_timelines(), plan);
       if (!planned) {
-        return unexpected(RouteError{carp::to_error(planned.error()), carp::to_string(planned.error().reason)});
+        return unexpected(plan_failure(planned.error()));
       }
       route = std::move(*planned);
       const auto& topology = model_->topology();

@@ -73,9 +73,13 @@ class RoutingAgent {
  private:
   /// A failed request: the error sent back and, for planning failures, the carp reason.
   struct RouteError {
+    RouteError(Error e, std::string f, std::vector<std::string> b = {})
+        : error(std::move(e)), failure(std::move(f)), blockers(std::move(b)) {}
     Error error;
     std::string failure;
+    std::vector<std::string> blockers;  ///< carp::PlanError::blockers
   };
+  static RouteError plan_failure(const carp::PlanError& error);
   template <class Req, class Rep>
   using Client = std::unique_ptr<dds::ServiceClient<Req, Rep>>;
 

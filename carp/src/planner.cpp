@@ -1,10 +1,13 @@
 #include "drover/carp/planner.hpp"
 
+#include <algorithm>
 #include <deque>
 #include <optional>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include "drover/carp/free_path.hpp"
 #include "heuristic.hpp"
 #include "traversal.hpp"
 #include "window_search.hpp"
@@ -26,7 +29,7 @@ std::string time_text(TimeNs t) {
 }
 
 PlanError error(PlanFailure reason, std::string message) {
-  return PlanError{reason, std::move(message)};
+  return PlanError{reason, std::move(message), {}};
 }
 
 /// What keeps `agent` off `entity` at time t: a lock or another agent's reservation on the
@@ -83,6 +86,22 @@ std::string forever_blocker_text(const topology::Topology& topology, const Timel
   return blocker_text(topology, timelines, entity, agent, from);
 }
 
+/// Adds to `holders` the agents other than `agent` that hold `entity` open-ended, on the
+/// entity itself or on a member of its conflict set (whose shadows the entity's own
+/// timeline carries).
+void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, std::string_view agent,
+                            std::vector<std::string>& holders) {
+  if (!timelines.owns(entity)) return;
+  for (const topology::Reservation& r : timelines.timeline(entity).reservations) {
+    if (r.agent != agent && r.window.end == kForever) holders.push_back(r.agent);
+  }
+}
+
+void sort_unique(std::vector<std::string>& names) {
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+}
+
 /// True when any entity has a lock (else a search without locks would find nothing new).
 bool any_lock(const TimelineSet& timelines) {
   for (EntityIndex e = 0; e < timelines.entity_count(); ++e) {
@@ -121,9 +140,10 @@ struct Planner::Impl {
   WindowSearch search;
   std::vector<Leg> legs;
   std::vector<Interval> goal_windows;
+  FreePathSearch free_paths;  ///< only to name the blockers of a failed search
 
   Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
-      : graph(std::move(g)), options(o), heuristics(o.heuristic_tables) {}
+      : graph(std::move(g)), options(o), heuristics(o.heuristic_tables), free_paths(graph) {}
 
   const topology::Topology& topology() const { return graph->topology(); }
 
@@ -236,11 +256,34 @@ struct Planner::Impl {
     goal_windows.clear();
     timelines.append_free_windows(last.vertex, request.agent, request.start_time, kForever,
                                   goal_windows, false);
-    return error(open_ended(goal_windows) ? PlanFailure::locked : PlanFailure::no_window,
-                 fmt::format("the last stop {} is never free for good (open-ended) from {} on: {}",
-                             vertex_name(last.vertex), time_text(from),
-                             forever_blocker_text(topology(), timelines, last.vertex,
-                                                  request.agent, from)));
+    const bool locked = open_ended(goal_windows);
+    PlanError failure = error(locked ? PlanFailure::locked : PlanFailure::no_window,
+                              fmt::format("the last stop {} is never free for good (open-ended) from {} on: {}",
+                                          vertex_name(last.vertex), time_text(from),
+                                          forever_blocker_text(topology(), timelines, last.vertex,
+                                                               request.agent, from)));
+    if (!locked) {
+      add_open_ended_holders(timelines, last.vertex, request.agent, failure.blockers);
+      sort_unique(failure.blockers);
+    }
+    return failure;
+  }
+
+  /// The agents holding open-ended a vertex of the reservation-free fastest path through
+  /// the stops (the start excluded: the vehicle stands there).
+  std::vector<std::string> blockers_on_free_path(const TimelineSet& timelines, const PlanRequest& request) {
+    std::vector<std::string> blockers;
+    EntityIndex from = request.start;
+    for (const Stop& stop : request.stops) {
+      auto path = free_paths.find(request.vehicle, from, stop.vertex);
+      if (!path) break;
+      for (const EntityIndex v : path->vertices) {
+        if (v != request.start) add_open_ended_holders(timelines, v, request.agent, blockers);
+      }
+      from = stop.vertex;
+    }
+    sort_unique(blockers);
+    return blockers;
   }
 
   /// Explains a search that found nothing (only called then, so it may take its time).
@@ -272,9 +315,14 @@ struct Planner::Impl {
                                vertex_name(goal), time_text(options.horizon),
                                time_text(request.start_time)));
     }
-    return error(PlanFailure::no_window,
-                 fmt::format("other agents' reservations block every route to {} for good",
-                             vertex_name(goal)));
+    PlanError failure = error(PlanFailure::no_window,
+                              fmt::format("other agents' reservations block every route to {} for good",
+                                          vertex_name(goal)));
+    failure.blockers = blockers_on_free_path(timelines, request);
+    if (!failure.blockers.empty()) {
+      failure.message += fmt::format(" (standing in the way: {})", fmt::join(failure.blockers, ", "));
+    }
+    return failure;
   }
 
   Result<Route, PlanError> plan(const TimelineSet& timelines, const PlanRequest& request) {

@@ -199,8 +199,29 @@ TEST(Planner, ReportsNoWindowWhenTheGoalIsHeldForGoodByAnotherAgent) {
   const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
   EXPECT_EQ(e.reason, PlanFailure::no_window);
   EXPECT_NE(e.message.find("agent b"), std::string::npos) << e.message;
+  EXPECT_EQ(e.blockers, std::vector<std::string>{"b"});
   // A visit with a dwell needs no open-ended window.
   EXPECT_EQ(plan_ok(w, request_to(w, "a", "0,0", {dwell_stop(w, "2,0", 1)})).arrival, sec(2));
+}
+
+TEST(Planner, NamesTheAgentsStandingForGoodInTheWayAsBlockers) {
+  // b stands for good in the middle of a corridor, c at its far end: no route can get past
+  // b, and the failure names b (on the way) but not c (not on the way).
+  World w(GridBuilder().corridor(6).build());
+  w.occupy("b", "2,0", sec(0), kForever);
+  w.occupy("c", "5,0", sec(0), kForever);
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "4,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_EQ(e.blockers, std::vector<std::string>{"b"}) << e.message;
+  EXPECT_NE(e.message.find("standing in the way: b"), std::string::npos) << e.message;
+  // A stay that ends is no blocker: the route waits for it.
+  World later(GridBuilder().corridor(6).build());
+  later.occupy("b", "2,0", sec(0), sec(10));
+  EXPECT_GT(plan_ok(later, request_to(later, "a", "0,0", {open_stop(later, "4,0")})).arrival, sec(10));
+  // Locks are no agents: a corridor locked for good has no blockers.
+  World locked(GridBuilder().corridor(6).build());
+  ASSERT_TRUE(locked.timelines.lock(locked.at("2,0"), {sec(0), kForever}, "op", "broken plate"));
+  EXPECT_TRUE(plan_error(locked, request_to(locked, "a", "0,0", {open_stop(locked, "4,0")})).blockers.empty());
 }
 
 TEST(Planner, ReportsWhyTheStartIsNotFree) {

@@ -559,5 +559,32 @@ TEST_F(TimelineTest, CheckersAcceptAGoodStateAndCatchBrokenOnes) {
                   .empty());
 }
 
+// A replica of two partitions: entity 0 (one owner) carries amy's step 3 where her delay
+// already moved it, its conflicting neighbour 1 (the other owner) still the shadow where it
+// was. Planned on that, bob could take 1 in the gap, after amy's step there and before it
+// on 0: the allocation orders would cross. Widened, each copy spans the hull.
+TEST(TimelineReplica, StepHullsCloseTheGapBetweenCopiesThatOwnersMovedApart) {
+  TimelineSet replica{graph(3, {{0, 1}})};
+  Timeline zero;
+  zero.version = 5;
+  zero.reservations = {Reservation{"amy", 7, 3, 0, 0, {20, 22}, false}};
+  Timeline one;
+  one.version = 9;
+  one.reservations = {Reservation{"amy", 7, 3, 1, 0, {10, 12}, false},
+                      Reservation{"cat", 2, 0, 1, 1, {30, 31}, false}};
+  ASSERT_TRUE(replica.replace_timeline(0, zero));
+  ASSERT_TRUE(replica.replace_timeline(1, one));
+  EXPECT_TRUE(replica.free_windows(1, "bob", 0, 40) == windows({{0, 10}, {12, 30}, {31, 40}}));
+
+  replica.widen_to_step_hulls();
+  EXPECT_EQ(replica.timeline(0).reservations.front().window, (Interval{10, 22}));
+  EXPECT_EQ(replica.timeline(1).reservations.front().window, (Interval{10, 22}));
+  EXPECT_EQ(replica.timeline(1).reservations.back().window, (Interval{30, 31}));
+  EXPECT_EQ(replica.version(0), 5u);
+  EXPECT_EQ(replica.version(1), 9u);
+  EXPECT_TRUE(replica.free_windows(1, "bob", 0, 40) == windows({{0, 10}, {22, 30}, {31, 40}}));
+  EXPECT_TRUE(replica.free_windows(0, "bob", 0, 40) == windows({{0, 10}, {22, 40}}));
+}
+
 }  // namespace
 }  // namespace drover::topology

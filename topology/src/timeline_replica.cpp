@@ -1,5 +1,8 @@
 // TimelineSet::replace_timeline: how a routing agent's replica takes in a published timeline.
 
+#include <map>
+#include <tuple>
+
 #include "timeline_impl.hpp"
 
 namespace drover::topology {
@@ -17,6 +20,28 @@ Status TimelineSet::replace_timeline(EntityIndex entity, Timeline timeline) {
   }
   timelines_[entity] = std::move(timeline);
   return {};
+}
+
+void TimelineSet::widen_to_step_hulls() {
+  using StepKey = std::tuple<AgentId, RouteId, std::uint32_t>;
+  std::map<StepKey, Interval> hulls;
+  for (const Timeline& timeline : timelines_) {
+    for (const Reservation& r : timeline.reservations) {
+      auto [hull, first] = hulls.try_emplace({r.agent, r.route, r.step}, r.window);
+      if (first) continue;
+      hull->second.start = std::min(hull->second.start, r.window.start);
+      hull->second.end = std::max(hull->second.end, r.window.end);
+    }
+  }
+  for (Timeline& timeline : timelines_) {
+    bool widened = false;
+    for (Reservation& r : timeline.reservations) {
+      const Interval& hull = hulls.at({r.agent, r.route, r.step});
+      widened = widened || hull != r.window;
+      r.window = hull;
+    }
+    if (widened) Impl::sort_reservations(timeline);
+  }
 }
 
 }  // namespace drover::topology

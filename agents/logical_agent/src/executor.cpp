@@ -82,6 +82,11 @@ void LogicalAgent::run() {
       set_activity(Activity::idle);
       continue;
     }
+    if (auto requester = make_way_requested()) {
+      make_way(*requester);
+      set_activity(Activity::idle);
+      continue;
+    }
     if (options_.park_after >= 0 && activity_ == Activity::idle && vertex_ &&
         topology_->vertex(*vertex_).kind != topology::VertexKind::parking &&
         clock_.now() - idle_since_ >= options_.park_after) {
@@ -238,6 +243,12 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
         spdlog::info("no route to '{}' yet ({}): retrying", topology_->id(goal), status.error().message);
         warned = true;
       }
+      ask_make_way({reply->blockers().begin(), reply->blockers().end()}, goal);
+      // Waiting here, the vehicle may itself stand in another's way (two vehicles that want
+      // each other's place): it drives aside, then plans from there.
+      if (!making_way_) {
+        if (auto requester = make_way_requested(); requester && make_way(*requester)) continue;
+      }
       set_activity(Activity::waiting);
       std::unique_lock lock(mutex_);
       wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
@@ -265,6 +276,10 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     wake_.wait_for(lock, options_.tick, [&] { return stopping_.load(); });
   }
   if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
+  if (next.size() > 1) {
+    std::lock_guard lock(mutex_);
+    make_way_.reset();  // the vehicle leaves anyway
+  }
   monitor_.forget_steps();
   monitor_.hold(here, 0);
   next.mark_allocated();
@@ -634,28 +649,32 @@ void LogicalAgent::execute_order() {
   }
 }
 
-void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
-  const bool charger = kind == topology::VertexKind::charger;
+bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do) {
+  if (here_will_do && topology_->vertex(*vertex_).kind == kind) return true;
   const auto here = topology_->vertex(*vertex_).position;
   std::vector<topology::EntityIndex> candidates;
   for (topology::EntityIndex v = 0; v < topology_->vertex_count(); ++v) {
-    if (topology_->vertex(v).kind == kind) candidates.push_back(v);
+    if (topology_->vertex(v).kind == kind && v != *vertex_) candidates.push_back(v);
   }
   std::sort(candidates.begin(), candidates.end(), [&](auto a, auto b) {
     return bg::distance(here, topology_->vertex(a).position) < bg::distance(here, topology_->vertex(b).position);
   });
+  const bool charger = kind == topology::VertexKind::charger;
   const Activity activity = charger ? Activity::charging : Activity::parking;
-  bool reached = topology_->vertex(*vertex_).kind == kind;
   for (const auto candidate : candidates) {
-    if (reached || stopping_) break;
+    if (stopping_) break;
     spdlog::info("{}: trying '{}'", charger ? "going to charge" : "parking", topology_->id(candidate));
-    if (auto driven = drive_to(candidate, activity, 0); driven) {
-      reached = true;
-    } else {
-      spdlog::info("'{}' not reached: {}", topology_->id(candidate), driven.error().message);
-      if (!route_) return;  // the route failed on the way (an alarm was raised)
-    }
+    const auto driven = drive_to(candidate, activity, 0);
+    if (driven) return true;
+    spdlog::info("'{}' not reached: {}", topology_->id(candidate), driven.error().message);
+    if (!route_) return false;  // the route failed on the way (an alarm was raised)
   }
+  return false;
+}
+
+void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
+  const bool charger = kind == topology::VertexKind::charger;
+  const bool reached = drive_to_nearest(kind, true);
   idle_since_ = clock_.now();
   if (!reached) {
     if (charger) charge_retry_at_ = clock_.now() + kChargeRetry;

@@ -76,6 +76,9 @@ Status LogicalAgent::start() {
   auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, dds::TopicQos::events());
   if (!alarms) return unexpected(alarms.error());
   alarm_writer_ = std::move(*alarms);
+  auto make_way = dds::Writer<msg::MakeWayRequest>::create(*participant_, kMakeWayTopic, dds::TopicQos::events());
+  if (!make_way) return unexpected(make_way.error());
+  make_way_writer_ = std::move(*make_way);
 
   dds::HeartbeatOptions beat;
   beat.kind = "logical";
@@ -99,6 +102,16 @@ Status LogicalAgent::start() {
   if (!notices) return unexpected(notices.error());
   notice_reader_ = std::move(*notices);
 
+  dds::ReaderOptions make_way_options;
+  make_way_options.qos = dds::TopicQos::events();
+  make_way_options.filter_expression = "vehicle = %0";
+  make_way_options.filter_parameters = {"'" + vehicle_id() + "'"};
+  auto asked = dds::Reader<msg::MakeWayRequest>::create(
+      *participant_, kMakeWayTopic, [this](const msg::MakeWayRequest& request) { on_make_way(request); },
+      make_way_options);
+  if (!asked) return unexpected(asked.error());
+  make_way_reader_ = std::move(*asked);
+
   auto server = dds::ServiceServer<msg::OrderRequest, msg::OrderReply>::create(
       *participant_, kServiceArea, kOrderService,
       [this](const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply) {
@@ -119,9 +132,11 @@ LogicalAgent::~LogicalAgent() {
   wake_.notify_all();
   if (executor_.joinable()) executor_.join();
   order_server_.reset();
+  make_way_reader_.reset();
   notice_reader_.reset();
   ran_.reset();
   heartbeat_.reset();
+  make_way_writer_.reset();
   alarm_writer_.reset();
   vehicle_writer_.reset();
   progress_writer_.reset();
@@ -173,6 +188,16 @@ void LogicalAgent::on_notice(const msg::ReservationNotice& notice) {
   {
     std::lock_guard lock(mutex_);
     notices_.push_back(notice);
+    ++events_;
+  }
+  wake_.notify_all();
+}
+
+void LogicalAgent::on_make_way(const msg::MakeWayRequest& request) {
+  if (request.vehicle() != vehicle_id()) return;
+  {
+    std::lock_guard lock(mutex_);
+    make_way_ = MakeWay{request.requester(), request.location(), request.time().ns()};
     ++events_;
   }
   wake_.notify_all();

@@ -99,6 +99,7 @@ class LogicalAgent {
   // ---- DDS callbacks (record and wake) ----
   void on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply);
   void on_notice(const msg::ReservationNotice& notice);
+  void on_make_way(const msg::MakeWayRequest& request);
   void on_status(const ran::VehicleStatus& status);
   void publish_progress(const Order& order);
 
@@ -130,6 +131,21 @@ class LogicalAgent {
   void execute_order();
   /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
   void go_to_service_vertex(topology::VertexKind kind);
+  /// Drives to the nearest vertex of `kind` other than the one the vehicle stands on (or,
+  /// with `here_will_do`, stays where it is when that is of `kind`).
+  /// \return whether it stands on one now.
+  bool drive_to_nearest(topology::VertexKind kind, bool here_will_do);
+
+  // ---- making way (make_way.cpp) ----
+  /// Asks each of `blockers` (vehicles standing for good in the way to `goal`) to make
+  /// way, at most once per kMakeWayRepeat each.
+  void ask_make_way(const std::vector<std::string>& blockers, topology::EntityIndex goal);
+  /// \return the request to make way still in force, if any (a request older than
+  ///         kMakeWayValid is dropped: a requester still blocked asks again).
+  std::optional<std::string> make_way_requested();
+  /// Drives the standing vehicle off its vertex to a free parking vertex, for whoever
+  /// asked. \return whether it moved.
+  bool make_way(const std::string& requester);
   /// Gives up the current route after a failure: cancels its reservations, releases what
   /// the footprint does not touch, holds the vertex the vehicle stands on again.
   void abandon_route();
@@ -160,6 +176,13 @@ class LogicalAgent {
   std::optional<ran::VehicleStatus> status_;
   std::chrono::steady_clock::time_point status_received_{};
   std::map<ran::CommandId, ran::CommandProgress> ended_commands_;  ///< ours, once terminal
+  /// The latest request to make way for another vehicle.
+  struct MakeWay {
+    std::string requester;
+    std::string location;
+    TimeNs time = 0;
+  };
+  std::optional<MakeWay> make_way_;
 
   // Executor state.
   FootprintMonitor monitor_;
@@ -175,6 +198,8 @@ class LogicalAgent {
   Activity drive_activity_ = Activity::driving;
   TimeNs charge_retry_at_ = 0;
   bool position_alarm_raised_ = false;
+  bool making_way_ = false;                          ///< driving aside: requests wait
+  std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked
   std::string command_prefix_;
   std::mt19937_64 route_ids_;
   msg::VehicleState last_published_;
@@ -186,9 +211,11 @@ class LogicalAgent {
   std::unique_ptr<dds::Writer<msg::OrderProgress>> progress_writer_;
   std::unique_ptr<dds::Writer<msg::VehicleState>> vehicle_writer_;
   std::unique_ptr<dds::Writer<msg::OperatorAlarm>> alarm_writer_;
+  std::unique_ptr<dds::Writer<msg::MakeWayRequest>> make_way_writer_;
   std::unique_ptr<dds::HeartbeatPublisher> heartbeat_;
   std::unique_ptr<ran::RanClient> ran_;
   std::unique_ptr<dds::Reader<msg::ReservationNotice>> notice_reader_;
+  std::unique_ptr<dds::Reader<msg::MakeWayRequest>> make_way_reader_;
   std::unique_ptr<dds::ServiceServer<msg::OrderRequest, msg::OrderReply>> order_server_;
   std::thread executor_;
 };

@@ -66,6 +66,12 @@ const char* to_string(PlanFailure failure) noexcept;
 struct PlanError {
   PlanFailure reason = PlanFailure::invalid_request;
   std::string message;  ///< names the vertices and times involved
+  /// For a no_window failure that lasts for good: the agents whose open-ended holds (a
+  /// vehicle standing on its last stop, idle or waiting for work) stand in the way, on the
+  /// last stop or along the reservation-free fastest path to it. The route may exist once
+  /// they move: a logical agent asks them to make way. Sorted, without duplicates; empty
+  /// for every other failure.
+  std::vector<std::string> blockers;
 };
 
 /// The library-wide error for a planning failure (code chosen by reason).

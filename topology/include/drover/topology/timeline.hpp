@@ -324,6 +324,16 @@ class TimelineSet {
   /// \return not_found for an entity not owned.
   Status replace_timeline(EntityIndex entity, Timeline timeline);
 
+  /// For a replica assembled from several partitions' timelines: sets the window of every
+  /// copy of a route step (its real reservation and its shadows, published by different
+  /// owners) to the hull of all its copies here, keeping each timeline sorted. The copies
+  /// of one step drift apart while a delay travels from one partition to the next; a route
+  /// planned in the gap between them would come after the step on one entity and before
+  /// it on a conflicting one, and the allocation order (I2) would deadlock both vehicles.
+  /// Planned on the hulls, a new route comes before or after each step everywhere alike.
+  /// Versions are kept (prepares are checked against the published ones).
+  void widen_to_step_hulls();
+
   // ---- persistence (timeline_snapshot.cpp) ----
 
   /// The committed state of every owned entity that is not empty at version 0 (see

@@ -13,5 +13,6 @@ DROVER_DDS_MESSAGE(OrderReply);
 DROVER_DDS_MESSAGE(OrderProgress);
 DROVER_DDS_MESSAGE(VehicleState);
 DROVER_DDS_MESSAGE(OperatorAlarm);
+DROVER_DDS_MESSAGE(MakeWayRequest);
 
 }  // namespace drover::dds

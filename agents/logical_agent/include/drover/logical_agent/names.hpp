@@ -14,5 +14,7 @@ inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progres
 inline constexpr const char* kVehicleStateTopic = "drover/logical/vehicle";
 /// Event topic of OperatorAlarm (RELIABLE + VOLATILE + KEEP_ALL).
 inline constexpr const char* kAlarmTopic = "drover/operator/alarm";
+/// Event topic of MakeWayRequest (RELIABLE + VOLATILE + KEEP_ALL), read filtered on `vehicle`.
+inline constexpr const char* kMakeWayTopic = "drover/logical/make_way";
 
 }  // namespace drover::logical_agent
