@@ -346,6 +346,16 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
 
 void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle reply) {
   std::lock_guard lock(mutex_);
+  if (request.shadows_only()) {
+    const auto origin = topology_.find(request.entity());
+    if (!origin) {
+      return send_error(reply, Error{ErrorCode::not_found, "unknown entity '" + request.entity() +
+                                                               "' in topology '" + topology_.name() + "'"});
+    }
+    auto grants = timelines_.release_shadows(request.agent(), request.route(), request.step(), *origin);
+    if (!grants) return send_error(reply, grants.error());
+    return send_status(reply, after_change(*grants, {}));
+  }
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
   const auto step = timelines_.allocated_step(*entity);

@@ -272,6 +272,28 @@ TEST(TimelinePartition, AnOwnerKeepsOnlyItsOwnEntities) {
             ErrorCode::not_found);
 }
 
+TEST(TimelinePartition, ShadowsOfAStepReleasedByItsOwnerGoOnRequest) {
+  // This set owns 0 and 2; 1 (the neighbour's) conflicts with 0. amy's route 7 passes 1
+  // as step 3: her shadow on 0 came here as a prepare. bob comes later on 0.
+  TimelineSet part(graph(3, {{0, 1}}), {true, false, true});
+  auto prepared = part.prepare({Reservation{"amy", 7, 3, 0, 1, {0, 10}, false}}, {}, 100);
+  ASSERT_TRUE(prepared.has_value());
+  ASSERT_TRUE(part.commit(*prepared));
+  ASSERT_TRUE(part.reserve("bob", 1, {at(0, 20, 30)}));
+  const auto queued = part.allocate("bob", 0);
+  ASSERT_TRUE(queued.has_value());
+  EXPECT_FALSE(queued->granted) << "amy's shadow comes first";
+
+  EXPECT_EQ(part.release_shadows("amy", 7, 3, 0).error().code, ErrorCode::not_permitted);  // owned here
+  EXPECT_TRUE(part.release_shadows("amy", 7, 2, 1)->empty()) << "another step: nothing to remove";
+  EXPECT_EQ(part.timeline(0).reservations.size(), 2u);
+  const auto grants = part.release_shadows("amy", 7, 3, 1);
+  ASSERT_TRUE(grants.has_value());
+  EXPECT_EQ(*grants, (std::vector<Grant>{Grant{"bob", 0}}));
+  EXPECT_EQ(part.timeline(0).holder, AgentId("bob"));
+  EXPECT_TRUE(part.release_shadows("amy", 7, 3, 1)->empty()) << "repeated: no change";
+}
+
 // ---- free windows ---------------------------------------------------------------------
 
 TEST_F(TimelineTest, FreeWindowsLeaveOutOthersReservationsAndLocksOnTheConflictSet) {

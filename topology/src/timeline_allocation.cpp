@@ -114,6 +114,28 @@ Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityInde
   return grants;
 }
 
+Result<std::vector<Grant>> TimelineSet::release_shadows(const AgentId& agent, RouteId route, std::uint32_t step,
+                                                        EntityIndex origin) {
+  if (agent.empty()) return fail(ErrorCode::invalid_argument, "release_shadows: empty agent id");
+  if (origin >= conflict_sets_.size()) {
+    return fail(ErrorCode::not_found, "release_shadows: no entity " + std::to_string(origin));
+  }
+  if (owns(origin)) {
+    return fail(ErrorCode::not_permitted, "release_shadows: entity " + std::to_string(origin) +
+                                              " is owned here: its allocation is given up with release");
+  }
+  const auto of_step = [&](const Reservation& r) {
+    return r.agent == agent && r.route == route && r.step == step && r.origin == origin;
+  };
+  TouchedSet touched;
+  for (EntityIndex f : conflict_sets_[origin]) {
+    if (owns(f) && std::erase_if(timelines_[f].reservations, of_step) > 0) touched.insert(f);
+  }
+  std::vector<Grant> grants = Impl::grant_waiting(*this, TouchedSet(touched), touched);
+  Impl::bump_versions(*this, touched);
+  return grants;
+}
+
 Result<std::vector<Grant>> TimelineSet::cancel_route(const AgentId& agent, RouteId route) {
   if (agent.empty()) return fail(ErrorCode::invalid_argument, "cancel_route: empty agent id");
   const auto of_route = [&](const Reservation& r) { return r.agent == agent && r.route == route; };

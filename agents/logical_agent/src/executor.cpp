@@ -262,7 +262,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   // route's first step (nobody can come between: the new reservation starts now and the
   // old one held the vertex since the vehicle arrived).
   if (monitor_.holds(here)) {
-    if (auto released = services_->release(vehicle_id(), here); !released) return released;
+    if (auto released = services_->release(vehicle_id(), here, held_step(here)); !released) return released;
     monitor_.drop(here);
   }
   for (;;) {
@@ -421,12 +421,18 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
 
 void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
   for (const auto entity : monitor_.releasable(status.footprint, route_ ? route_->reached() : 0)) {
-    if (auto released = services_->release(vehicle_id(), entity); !released) {
+    if (auto released = services_->release(vehicle_id(), entity, held_step(entity)); !released) {
       spdlog::warn("release of '{}' failed: {}", topology_->id(entity), released.error().message);
       continue;
     }
     monitor_.drop(entity);
   }
+}
+
+std::optional<HeldStep> LogicalAgent::held_step(topology::EntityIndex entity) const {
+  const auto step = monitor_.step_of(entity);
+  if (!step || !route_) return std::nullopt;
+  return HeldStep{route_->id(), static_cast<std::uint32_t>(*step)};
 }
 
 std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& status) {
@@ -573,7 +579,7 @@ void LogicalAgent::abandon_route() {
   monitor_.forget_steps();
   if (const auto status = latest_status()) {
     for (const auto entity : monitor_.releasable(status->footprint, 0)) {
-      if (services_->release(vehicle_id(), entity)) monitor_.drop(entity);
+      if (services_->release(vehicle_id(), entity, std::nullopt)) monitor_.drop(entity);
     }
   }
   route_.reset();

@@ -26,6 +26,12 @@ class FootprintMonitor {
   /// Marks every held entity a leftover of an earlier route (a new route begins).
   void forget_steps();
   bool holds(topology::EntityIndex entity) const { return held_.count(entity) != 0; }
+  /// The current route's step `entity` is held as; nullopt for a leftover or an entity
+  /// not held.
+  std::optional<std::size_t> step_of(topology::EntityIndex entity) const {
+    const auto found = held_.find(entity);
+    return found == held_.end() ? std::nullopt : found->second;
+  }
   std::vector<topology::EntityIndex> held() const;
 
   /// Area (m^2) of `footprint` outside the union of the held entities' footprints.

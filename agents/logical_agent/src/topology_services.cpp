@@ -1,5 +1,6 @@
 #include "agents/logical_agent/src/topology_services.hpp"
 
+#include <set>
 #include <thread>
 
 #include <spdlog/spdlog.h>
@@ -60,14 +61,18 @@ Result<T> TopologyServices::retry(const std::function<Result<T>()>& call) const 
 }
 
 Result<std::string> TopologyServices::owner_of(topology::EntityIndex entity) const {
-  const std::string& partition = topology_->partition(entity);
+  auto owner = owner_of_partition(topology_->partition(entity));
+  if (!owner) return fail(owner.error().code, owner.error().message + " (entity '" + topology_->id(entity) + "')");
+  return owner;
+}
+
+Result<std::string> TopologyServices::owner_of_partition(const std::string& partition) const {
   for (const auto& agent : directory_->live_agents()) {
     if (agent.kind == "topology" && std::find(agent.owns.begin(), agent.owns.end(), partition) != agent.owns.end()) {
       return agent.id;
     }
   }
-  return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "' (entity '" +
-                                          topology_->id(entity) + "')");
+  return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "'");
 }
 
 std::vector<std::string> TopologyServices::partitions_of(const std::string& agent_id) const {
@@ -99,22 +104,42 @@ Result<AllocateOutcome> TopologyServices::allocate(const std::string& agent, top
   return AllocateOutcome{reply->granted(), reply->queue_position()};
 }
 
-Status TopologyServices::release(const std::string& agent, topology::EntityIndex entity) {
-  auto done = retry<bool>([&]() -> Result<bool> {
-    auto owner = owner_of(entity);
-    if (!owner) return unexpected(owner.error());
-    msg::ReleaseRequest request;
-    request.agent(agent);
-    request.entity(topology_->id(entity));
-    auto reply = release_client_->call(request, call_timeout_, *owner);
-    if (!reply) return unexpected(reply.error());
-    if (auto status = dds::from_wire(reply->error()); !status) {
-      if (status.error().code == ErrorCode::not_permitted) return false;
-      return unexpected(status.error());
+Status TopologyServices::release(const std::string& agent, topology::EntityIndex entity,
+                                 std::optional<HeldStep> held) {
+  const auto send = [&](const std::string& partition, bool shadows_only) {
+    return retry<bool>([&]() -> Result<bool> {
+      auto owner = owner_of_partition(partition);
+      if (!owner) return unexpected(owner.error());
+      msg::ReleaseRequest request;
+      request.agent(agent);
+      request.entity(topology_->id(entity));
+      request.shadows_only(shadows_only);
+      if (held) {
+        request.route(held->route);
+        request.step(held->step);
+      }
+      auto reply = release_client_->call(request, call_timeout_, *owner);
+      if (!reply) return unexpected(reply.error());
+      if (auto status = dds::from_wire(reply->error()); !status) {
+        if (status.error().code == ErrorCode::not_permitted) return false;
+        return unexpected(status.error());
+      }
+      return true;
+    });
+  };
+  const std::string& home = topology_->partition(entity);
+  if (auto done = send(home, false); !done) return unexpected(done.error());
+  if (!held) return {};
+  std::set<std::string> others;
+  for (const auto member : topology_->conflicts(entity)) {
+    if (topology_->partition(member) != home) others.insert(topology_->partition(member));
+  }
+  for (const auto& partition : others) {
+    if (auto done = send(partition, true); !done) {
+      spdlog::warn("shadows of '{}' (route {} step {}) not released in partition '{}': {}", topology_->id(entity),
+                   held->route, held->step, partition, done.error().message);
     }
-    return true;
-  });
-  if (!done) return unexpected(done.error());
+  }
   return {};
 }
 

@@ -27,6 +27,12 @@ struct AllocateOutcome {
   std::size_t queue_position = 0;
 };
 
+/// The route step an allocation was granted as.
+struct HeldStep {
+  topology::RouteId route = 0;
+  std::uint32_t step = 0;
+};
+
 /// Thread-safe. Must be destroyed before its Participant.
 class TopologyServices {
  public:
@@ -46,8 +52,11 @@ class TopologyServices {
   Result<AllocateOutcome> allocate(const std::string& agent, topology::EntityIndex entity,
                                    std::chrono::milliseconds timeout);
   /// Releases `entity`, retrying while the owner does not answer. not_permitted (we do not
-  /// hold it) counts as done. \return success, or the owner's error.
-  Status release(const std::string& agent, topology::EntityIndex entity);
+  /// hold it) counts as done. With `held` (the route step the allocation was), the other
+  /// partitions owning members of the entity's conflict set then drop that step's shadows
+  /// (a failure there is logged: the shadows go at the latest with the route).
+  /// \return success, or the owner's error.
+  Status release(const std::string& agent, topology::EntityIndex entity, std::optional<HeldStep> held);
   /// Delays `route` from its step on `entity` by `by`. \return the reply's shifts, or the
   /// owner's error.
   Result<std::vector<topology::Shift>> delay(const std::string& agent, topology::RouteId route,
@@ -58,6 +67,8 @@ class TopologyServices {
 
   /// The live topology agent owning `entity`. \return its id, or unavailable.
   Result<std::string> owner_of(topology::EntityIndex entity) const;
+  /// The live topology agent owning `partition`. \return its id, or unavailable.
+  Result<std::string> owner_of_partition(const std::string& partition) const;
   /// The partitions the agent `agent_id` says it owns (empty when unknown).
   std::vector<std::string> partitions_of(const std::string& agent_id) const;
 

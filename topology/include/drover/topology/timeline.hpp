@@ -285,6 +285,14 @@ class TimelineSet {
   /// \return the waiting requests that this made grantable (now granted), by entity.
   Result<std::vector<Grant>> release(const AgentId& agent, EntityIndex entity);
 
+  /// For a partition that does not own `origin`: after its owner released the agent's
+  /// allocation of (route, step) there, removes that step's shadows from the owned
+  /// members of C(origin). Removing nothing is no error (a repeated request).
+  /// \return the waiting requests that this made grantable (now granted); not_permitted
+  ///         when `origin` is owned here (use release).
+  Result<std::vector<Grant>> release_shadows(const AgentId& agent, RouteId route, std::uint32_t step,
+                                             EntityIndex origin);
+
   /// Removes every reservation of (agent, route) that is not allocated, with shadows, also
   /// held (prepared) ones, whose prepared sets are dropped; withdraws the agent's waiting
   /// requests where no committed reservation of it is left. not_found if the route has
