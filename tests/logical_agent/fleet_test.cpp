@@ -664,6 +664,30 @@ TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
   EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
 }
 
+TEST_F(FleetTest, IdleVehicleStandingOnAnothersDestinationMakesWay) {
+  constexpr std::uint32_t kDomain = 85;
+  Fleet fleet(kDomain, "make_way");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  // V2 stands idle on left-4 and never parks by itself; V1 is sent there.
+  fleet.start_vehicle("V2", "left-4");
+  fleet.start_vehicle("V1", "right-4");
+  ASSERT_TRUE(wait_ready("V2", "left-4"));
+  ASSERT_TRUE(wait_ready("V1", "right-4"));
+  ASSERT_EQ(send_order("V1", "v1-to-v2", {{"left-4", "NOP"}}), "");
+
+  const auto done = wait_order("v1-to-v2");
+  ASSERT_TRUE(done.has_value()) << "V1's order did not end";
+  EXPECT_EQ(done->state(), msg::ORDER_FINISHED) << done->failure();
+  // V2 made way to the free parking vertex nearest to it, and stands there.
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders["left-0"] == "V2"; }, 60s)) << "V2 is not on left-0";
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_EQ(seen_.holders["left-4"], "V1");
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  EXPECT_TRUE(seen_.alarms.empty()) << seen_.alarms.front().text();
+}
+
 TEST_F(FleetTest, VehicleUnderTheBatteryThresholdChargesBeforeItsOrder) {
   constexpr std::uint32_t kDomain = 92;
   Fleet fleet(kDomain, "charge");
