@@ -92,23 +92,14 @@ Status LogicalAgent::start() {
   if (!ran) return unexpected(ran.error());
   ran_ = std::move(*ran);
 
-  dds::ReaderOptions notice_options;
-  notice_options.qos = dds::TopicQos::events();
-  notice_options.filter_expression = "agent = %0";
-  notice_options.filter_parameters = {"'" + vehicle_id() + "'"};
   auto notices = dds::Reader<msg::ReservationNotice>::create(
       *participant_, kTopologyNoticeTopic, [this](const msg::ReservationNotice& notice) { on_notice(notice); },
-      notice_options);
+      events_naming_this_vehicle("agent"));
   if (!notices) return unexpected(notices.error());
   notice_reader_ = std::move(*notices);
-
-  dds::ReaderOptions make_way_options;
-  make_way_options.qos = dds::TopicQos::events();
-  make_way_options.filter_expression = "vehicle = %0";
-  make_way_options.filter_parameters = {"'" + vehicle_id() + "'"};
   auto asked = dds::Reader<msg::MakeWayRequest>::create(
       *participant_, kMakeWayTopic, [this](const msg::MakeWayRequest& request) { on_make_way(request); },
-      make_way_options);
+      events_naming_this_vehicle("vehicle"));
   if (!asked) return unexpected(asked.error());
   make_way_reader_ = std::move(*asked);
 
@@ -142,6 +133,14 @@ LogicalAgent::~LogicalAgent() {
   progress_writer_.reset();
   services_.reset();
   participant_.reset();
+}
+
+dds::ReaderOptions LogicalAgent::events_naming_this_vehicle(const std::string& field) const {
+  dds::ReaderOptions options;
+  options.qos = dds::TopicQos::events();
+  options.filter_expression = field + " = %0";
+  options.filter_parameters = {"'" + vehicle_id() + "'"};
+  return options;
 }
 
 void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply) {

@@ -96,6 +96,9 @@ class LogicalAgent {
   LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options);
   Status start();
 
+  /// Reader options for an event topic, keeping only samples whose `field` is this vehicle.
+  dds::ReaderOptions events_naming_this_vehicle(const std::string& field) const;
+
   // ---- DDS callbacks (record and wake) ----
   void on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply);
   void on_notice(const msg::ReservationNotice& notice);
