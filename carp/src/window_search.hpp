@@ -77,11 +77,15 @@ class WindowSearch {
     std::uint32_t sequence;  // push order
     std::uint32_t state;
     /// Ties go to the entry closer to the goal (smaller h: without the floor, the later
-    /// state), then to the newest: on grids many paths are equally fast, and going deep
-    /// along one spares exploring all of them.
+    /// state): on grids many paths are equally fast, and going deep along one spares
+    /// exploring all of them. Then to the earlier `ready`: the floor gives many states of a
+    /// delayed agent the same key and h, and taking the newest among them reached states
+    /// late first and expanded them again with each earlier `ready` found later (up to five
+    /// times per state on average for the worst agents). Then to the newest.
     bool operator>(const OpenEntry& o) const {
       if (f != o.f) return f > o.f;
       if (h != o.h) return h > o.h;
+      if (ready != o.ready) return ready > o.ready;
       return sequence < o.sequence;
     }
   };
