@@ -138,7 +138,9 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
 
   std::uint32_t edge_count = 0, vertex_count = 0;
   const std::uint32_t edge_first = windows_of(input, a.edge, edge_count);
-  const std::uint32_t vertex_first = windows_of(input, a.to, vertex_count);
+  // The destination's windows are read only once the edge is known to lead somewhere:
+  // reading a timeline is the dearest part of a move.
+  std::uint32_t vertex_first = kNone;
   const auto later_than = [this](std::uint32_t first, std::uint32_t count, TimeNs t) {
     const auto begin = windows_.begin() + first;
     return static_cast<std::uint32_t>(
@@ -154,6 +156,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     const TimeNs earliest_arrival = onto_edge + travel;
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
+    if (vertex_first == kNone) vertex_first = windows_of(input, a.to, vertex_count);
     for (std::uint32_t j = later_than(vertex_first, vertex_count, earliest_arrival);
          j < vertex_count; ++j) {
       const Interval window = windows_[vertex_first + j];
