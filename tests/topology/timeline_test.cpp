@@ -331,6 +331,19 @@ TEST_F(TimelineTest, ALockOnAConflictingEntityBlocksThroughTheShadow) {
   EXPECT_TRUE(set.free_windows(0, "amy", 0, 200) == windows({{100, 200}}));
 }
 
+TEST_F(TimelineTest, ALockTakenInThroughAReplicatedTimelineBlocksItsConflictSetUntilReplaced) {
+  // A routing agent's replica gets its locks only through replace_timeline.
+  Timeline published;
+  published.version = 3;
+  published.locks.push_back(Lock{9, 1, {0, 100}, "olga", "spill"});
+  ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{100, 200}}));
+  published.version = 4;
+  published.locks.clear();
+  ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{0, 200}}));
+}
+
 TEST_F(TimelineTest, LockRejectsBadRequests) {
   const TimelineSet before = set;
   EXPECT_EQ(set.lock(0, {5, 5}, "olga", "").error().code, ErrorCode::invalid_argument);

@@ -151,6 +151,7 @@ Result<LockReport> TimelineSet::lock(EntityIndex entity, Interval window,
     if (r.window.overlaps(window)) report.hit.push_back(r);
   }
   t.locks.push_back(Lock{report.id, entity, window, std::move(operator_id), std::move(reason)});
+  ++lock_count_;
   std::sort(t.locks.begin(), t.locks.end(), [](const Lock& a, const Lock& b) {
     return std::tie(a.window.start, a.id) < std::tie(b.window.start, b.id);
   });
@@ -165,7 +166,7 @@ Status TimelineSet::unlock(LockId id) {
     return fail(ErrorCode::not_found, "unlock: no lock with id " + std::to_string(id));
   }
   Timeline& t = timelines_[found->second];
-  std::erase_if(t.locks, [&](const Lock& lock) { return lock.id == id; });
+  lock_count_ -= std::erase_if(t.locks, [&](const Lock& lock) { return lock.id == id; });
   ++t.version;
   lock_entities_.erase(found);
   return {};

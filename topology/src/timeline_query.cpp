@@ -63,7 +63,7 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
     cursor = std::max(cursor, r.window.end);
   }
   if (cursor < until) out.push_back(Interval{cursor, until});
-  if (count_locks) {
+  if (count_locks && lock_count_ > 0) {
     const auto cut_locks = [&](EntityIndex x) {
       for (const Lock& lock : timelines_[x].locks) cut_from(out, base, lock.window);
     };

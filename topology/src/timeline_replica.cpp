@@ -15,6 +15,7 @@ Status TimelineSet::replace_timeline(EntityIndex entity, Timeline timeline) {
       held_[entity] = AllocatedStep{held->route, held->step};
     }
   }
+  lock_count_ = lock_count_ - timelines_[entity].locks.size() + timeline.locks.size();
   timelines_[entity] = std::move(timeline);
   return {};
 }

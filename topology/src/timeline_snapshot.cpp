@@ -267,6 +267,7 @@ Result<TimelineSet> TimelineSet::restore(std::vector<std::vector<EntityIndex>> c
     t.locks = es.locks;
     std::sort(t.locks.begin(), t.locks.end(), lock_order);
     for (const Lock& lock : t.locks) set.lock_entities_.emplace(lock.id, es.entity);
+    set.lock_count_ += t.locks.size();
     if (es.holding) {
       t.holder = es.holding->agent;
       set.held_[es.entity] = es.holding->step;

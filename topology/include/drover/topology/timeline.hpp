@@ -376,6 +376,9 @@ class TimelineSet {
   std::vector<std::optional<AllocatedStep>> held_;  // per entity; set iff its holder is
   std::map<PrepareId, PreparedSet> prepared_;
   std::map<LockId, EntityIndex> lock_entities_;   // where each lock lives
+  // Locks on all timelines (a replica's too): without any, a free-window query need not
+  // look at the conflict set's timelines, the dearest part of it (one cache miss each).
+  std::size_t lock_count_ = 0;
   std::vector<Grant> pending_grants_;             // see take_grants
   LockId next_lock_id_ = 1;
   PrepareId next_prepare_id_ = 1;
