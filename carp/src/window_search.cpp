@@ -40,6 +40,12 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
+void WindowSearch::prefetch_timeline(const SearchInput& input, EntityIndex entity) const {
+  if (entity_stamp_[entity] == generation_ || !input.timelines->owns(entity)) return;
+  const auto& reservations = input.timelines->timeline(entity).reservations;
+  if (!reservations.empty()) __builtin_prefetch(reservations.data());
+}
+
 void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
                               EntityIndex vertex) {
   block_stamp_[key] = generation_;
@@ -231,6 +237,13 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
       improve(block + (current.window - entity_first_[vertex]), current.entry, ready, index,
               kNone, 0, next_estimate);
     }
+  }
+  // Reading a timeline not read before misses the cache: start fetching all of them
+  // first, so that their misses overlap instead of coming one after another.
+  for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
+    if (!traversal.usable_arc(a)) continue;
+    prefetch_timeline(input, graph.arc(a).edge);
+    prefetch_timeline(input, graph.arc(a).to);
   }
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
     if (traversal.usable_arc(a)) drive(input, index, current, a, outcome);

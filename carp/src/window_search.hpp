@@ -116,6 +116,9 @@ class WindowSearch {
     count = entity_count_[entity];
     return entity_first_[entity];
   }
+  /// Starts loading the reservations of `entity` into the cache if its windows are still
+  /// to be read.
+  void prefetch_timeline(const SearchInput& input, topology::EntityIndex entity) const;
   /// Appends the free windows of `entity` to windows_ and records where they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
