@@ -19,7 +19,11 @@ void WindowSearch::begin(const SearchInput& input) {
     entity_stamp_.assign(entities, 0);
     entity_first_.assign(entities, 0);
     entity_count_.assign(entities, 0);
+    kept_.assign(entities, KeptWindows{});
+    kept_windows_.clear();
+    kept_live_ = 0;
   }
+  agent_bit_ = topology::TimelineSet::agent_bit(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
@@ -35,15 +39,48 @@ void WindowSearch::begin(const SearchInput& input) {
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
   entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-  input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever, windows_,
-                                       input.count_locks);
+  const KeptWindows* kept = input.count_locks ? &kept_windows(input, entity) : nullptr;
+  if (kept == nullptr || (kept->agents & agent_bit_) != 0) {
+    // Locks ignored, or the agent may have reservations there, which never block it.
+    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
+                                         windows_, input.count_locks);
+  } else {
+    // Read from an earlier time, they clip to the same windows: a held reservation only
+    // drops the windows before it, and those end before it starts.
+    for (std::uint32_t i = kept->first; i < kept->first + kept->count; ++i) {
+      const Interval window = kept_windows_[i];
+      if (window.end > input.start_time) {
+        windows_.push_back(Interval{std::max(window.start, input.start_time), window.end});
+      }
+    }
+  }
   entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
-void WindowSearch::prefetch_timeline(const SearchInput& input, EntityIndex entity) const {
-  if (entity_stamp_[entity] == generation_ || !input.timelines->owns(entity)) return;
-  const auto& reservations = input.timelines->timeline(entity).reservations;
-  if (!reservations.empty()) __builtin_prefetch(reservations.data());
+const WindowSearch::KeptWindows& WindowSearch::kept_windows(const SearchInput& input,
+                                                            EntityIndex entity) {
+  KeptWindows& kept = kept_[entity];
+  const std::uint64_t revision = input.timelines->windows_revision(entity);
+  if (kept.revision == revision && kept.from <= input.start_time) return kept;
+  if (kept_windows_.size() > 2 * kept_live_ + 4096) compact_kept_windows();
+  kept_live_ -= kept.count;
+  kept.revision = revision;
+  kept.from = input.start_time;
+  kept.first = static_cast<std::uint32_t>(kept_windows_.size());
+  kept.agents = input.timelines->append_newcomer_windows(entity, input.start_time, kept_windows_);
+  kept.count = static_cast<std::uint32_t>(kept_windows_.size()) - kept.first;
+  kept_live_ += kept.count;
+  return kept;
+}
+
+void WindowSearch::compact_kept_windows() {
+  spare_windows_.clear();
+  for (KeptWindows& kept : kept_) {
+    const auto begin = kept_windows_.begin() + kept.first;
+    kept.first = static_cast<std::uint32_t>(spare_windows_.size());
+    spare_windows_.insert(spare_windows_.end(), begin, begin + kept.count);
+  }
+  kept_windows_.swap(spare_windows_);
 }
 
 void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
@@ -237,13 +274,6 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
       improve(block + (current.window - entity_first_[vertex]), current.entry, ready, index,
               kNone, 0, next_estimate);
     }
-  }
-  // Reading a timeline not read before misses the cache: start fetching all of them
-  // first, so that their misses overlap instead of coming one after another.
-  for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-    if (!traversal.usable_arc(a)) continue;
-    prefetch_timeline(input, graph.arc(a).edge);
-    prefetch_timeline(input, graph.arc(a).to);
   }
   for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
     if (traversal.usable_arc(a)) drive(input, index, current, a, outcome);

@@ -116,11 +116,20 @@ class WindowSearch {
     count = entity_count_[entity];
     return entity_first_[entity];
   }
-  /// Starts loading the reservations of `entity` into the cache if its windows are still
-  /// to be read.
-  void prefetch_timeline(const SearchInput& input, topology::EntityIndex entity) const;
   /// Appends the free windows of `entity` to windows_ and records where they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
+  /// The windows of `entity` for an agent without reservations there, as kept between
+  /// searches (read again when the timelines revised them, or for an earlier start).
+  struct KeptWindows {
+    std::uint64_t revision = 0;  // TimelineSet::windows_revision when read; 0: never read
+    TimeNs from = 0;             // read from this time on
+    std::uint64_t agents = 0;    // TimelineSet::agent_bit of the agents with reservations
+    std::uint32_t first = 0;     // index into kept_windows_
+    std::uint32_t count = 0;
+  };
+  const KeptWindows& kept_windows(const SearchInput& input, topology::EntityIndex entity);
+  /// Drops the windows of kept_windows_ that no entity refers to any more.
+  void compact_kept_windows();
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex) {
@@ -147,6 +156,13 @@ class WindowSearch {
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
   std::vector<std::uint32_t> block_stamp_, block_first_;
   std::vector<topology::Interval> windows_;
+  // Free windows kept between searches, per entity: a plan reads thousands of timelines,
+  // and most have not changed since the plan before. Reading one costs a cache miss per
+  // few reservations, copying kept windows almost nothing.
+  std::vector<KeptWindows> kept_;
+  std::vector<topology::Interval> kept_windows_, spare_windows_;
+  std::size_t kept_live_ = 0;     // windows of kept_windows_ that an entity refers to
+  std::uint64_t agent_bit_ = 0;   // TimelineSet::agent_bit of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   std::uint32_t sequence_ = 0;

@@ -17,6 +17,7 @@ Status TimelineSet::replace_timeline(EntityIndex entity, Timeline timeline) {
   }
   lock_count_ = lock_count_ - timelines_[entity].locks.size() + timeline.locks.size();
   timelines_[entity] = std::move(timeline);
+  Impl::revise_around(*this, entity);
   return {};
 }
 
