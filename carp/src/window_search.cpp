@@ -19,7 +19,11 @@ void WindowSearch::begin(const SearchInput& input) {
     entity_stamp_.assign(entities, 0);
     entity_first_.assign(entities, 0);
     entity_count_.assign(entities, 0);
+    kept_.assign(entities, KeptWindows{});
+    kept_windows_.clear();
+    kept_live_ = 0;
   }
+  agent_bit_ = topology::TimelineSet::agent_bit(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
@@ -35,9 +39,48 @@ void WindowSearch::begin(const SearchInput& input) {
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
   entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-  input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever, windows_,
-                                       input.count_locks);
+  const KeptWindows* kept = input.count_locks ? &kept_windows(input, entity) : nullptr;
+  if (kept == nullptr || (kept->agents & agent_bit_) != 0) {
+    // Locks ignored, or the agent may have reservations there, which never block it.
+    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
+                                         windows_, input.count_locks);
+  } else {
+    // Read from an earlier time, they clip to the same windows: a held reservation only
+    // drops the windows before it, and those end before it starts.
+    for (std::uint32_t i = kept->first; i < kept->first + kept->count; ++i) {
+      const Interval window = kept_windows_[i];
+      if (window.end > input.start_time) {
+        windows_.push_back(Interval{std::max(window.start, input.start_time), window.end});
+      }
+    }
+  }
   entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
+}
+
+const WindowSearch::KeptWindows& WindowSearch::kept_windows(const SearchInput& input,
+                                                            EntityIndex entity) {
+  KeptWindows& kept = kept_[entity];
+  const std::uint64_t revision = input.timelines->windows_revision(entity);
+  if (kept.revision == revision && kept.from <= input.start_time) return kept;
+  if (kept_windows_.size() > 2 * kept_live_ + 4096) compact_kept_windows();
+  kept_live_ -= kept.count;
+  kept.revision = revision;
+  kept.from = input.start_time;
+  kept.first = static_cast<std::uint32_t>(kept_windows_.size());
+  kept.agents = input.timelines->append_newcomer_windows(entity, input.start_time, kept_windows_);
+  kept.count = static_cast<std::uint32_t>(kept_windows_.size()) - kept.first;
+  kept_live_ += kept.count;
+  return kept;
+}
+
+void WindowSearch::compact_kept_windows() {
+  spare_windows_.clear();
+  for (KeptWindows& kept : kept_) {
+    const auto begin = kept_windows_.begin() + kept.first;
+    kept.first = static_cast<std::uint32_t>(spare_windows_.size());
+    spare_windows_.insert(spare_windows_.end(), begin, begin + kept.count);
+  }
+  kept_windows_.swap(spare_windows_);
 }
 
 void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
@@ -138,7 +181,9 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
 
   std::uint32_t edge_count = 0, vertex_count = 0;
   const std::uint32_t edge_first = windows_of(input, a.edge, edge_count);
-  const std::uint32_t vertex_first = windows_of(input, a.to, vertex_count);
+  // The destination's windows are read only once the edge is known to lead somewhere:
+  // reading a timeline is the dearest part of a move.
+  std::uint32_t vertex_first = kNone;
   const auto later_than = [this](std::uint32_t first, std::uint32_t count, TimeNs t) {
     const auto begin = windows_.begin() + first;
     return static_cast<std::uint32_t>(
@@ -154,6 +199,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     const TimeNs earliest_arrival = onto_edge + travel;
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
+    if (vertex_first == kNone) vertex_first = windows_of(input, a.to, vertex_count);
     for (std::uint32_t j = later_than(vertex_first, vertex_count, earliest_arrival);
          j < vertex_count; ++j) {
       const Interval window = windows_[vertex_first + j];

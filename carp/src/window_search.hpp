@@ -77,11 +77,15 @@ class WindowSearch {
     std::uint32_t sequence;  // push order
     std::uint32_t state;
     /// Ties go to the entry closer to the goal (smaller h: without the floor, the later
-    /// state), then to the newest: on grids many paths are equally fast, and going deep
-    /// along one spares exploring all of them.
+    /// state): on grids many paths are equally fast, and going deep along one spares
+    /// exploring all of them. Then to the earlier `ready`: the floor gives many states of a
+    /// delayed agent the same key and h, and taking the newest among them reached states
+    /// late first and expanded them again with each earlier `ready` found later (up to five
+    /// times per state on average for the worst agents). Then to the newest.
     bool operator>(const OpenEntry& o) const {
       if (f != o.f) return f > o.f;
       if (h != o.h) return h > o.h;
+      if (ready != o.ready) return ready > o.ready;
       return sequence < o.sequence;
     }
   };
@@ -114,6 +118,18 @@ class WindowSearch {
   }
   /// Appends the free windows of `entity` to windows_ and records where they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
+  /// The windows of `entity` for an agent without reservations there, as kept between
+  /// searches (read again when the timelines revised them, or for an earlier start).
+  struct KeptWindows {
+    std::uint64_t revision = 0;  // TimelineSet::windows_revision when read; 0: never read
+    TimeNs from = 0;             // read from this time on
+    std::uint64_t agents = 0;    // TimelineSet::agent_bit of the agents with reservations
+    std::uint32_t first = 0;     // index into kept_windows_
+    std::uint32_t count = 0;
+  };
+  const KeptWindows& kept_windows(const SearchInput& input, topology::EntityIndex entity);
+  /// Drops the windows of kept_windows_ that no entity refers to any more.
+  void compact_kept_windows();
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex) {
@@ -140,6 +156,13 @@ class WindowSearch {
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
   std::vector<std::uint32_t> block_stamp_, block_first_;
   std::vector<topology::Interval> windows_;
+  // Free windows kept between searches, per entity: a plan reads thousands of timelines,
+  // and most have not changed since the plan before. Reading one costs a cache miss per
+  // few reservations, copying kept windows almost nothing.
+  std::vector<KeptWindows> kept_;
+  std::vector<topology::Interval> kept_windows_, spare_windows_;
+  std::size_t kept_live_ = 0;     // windows of kept_windows_ that an entity refers to
+  std::uint64_t agent_bit_ = 0;   // TimelineSet::agent_bit of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   std::uint32_t sequence_ = 0;

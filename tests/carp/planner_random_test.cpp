@@ -290,5 +290,66 @@ TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {
   }
 }
 
+/// Plans `request` with the kept planner and with a fresh one: the windows the kept one
+/// keeps between plans must never differ from what the timelines say now.
+void expect_like_a_fresh_planner(World& w, const topology::TimelineSet& timelines,
+                                 const PlanRequest& request) {
+  const auto kept = w.planner.plan(timelines, request);
+  const auto fresh = Planner(w.graph).plan(timelines, request);
+  ASSERT_EQ(kept.has_value(), fresh.has_value());
+  if (kept) {
+    EXPECT_EQ(kept->steps, fresh->steps);
+  } else {
+    EXPECT_EQ(kept.error().reason, fresh.error().reason);
+  }
+}
+
+TEST(PlannerRandom, APlannerKeptAcrossChangesOfTheTimelinesAnswersLikeAFreshOne) {
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> coin(0, 1);
+  for (int trial = 0; trial < 60; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    World w(random_grid(rng));
+    random_traffic(w, rng);
+    std::uniform_int_distribution<EntityIndex> entity(
+        0, static_cast<EntityIndex>(w.topology.entity_count() - 1));
+    std::vector<topology::LockId> locks;
+    for (int change = 0; change < 12; ++change) {
+      PlanRequest request = random_request(w, rng);
+      request.start_time = sec(std::uniform_int_distribution<int>(0, 20)(rng));
+      expect_like_a_fresh_planner(w, w.timelines, request);
+      // A copy that moves on alone must not be mistaken for the original, nor the reverse.
+      topology::TimelineSet copy = w.timelines;
+      const EntityIndex e = entity(rng);
+      const int from = std::uniform_int_distribution<int>(0, 40)(rng);
+      (void)copy.reserve("c", w.next_route++, {{e, {sec(from), sec(from + 3)}}});
+      expect_like_a_fresh_planner(w, copy, request);
+      expect_like_a_fresh_planner(w, w.timelines, request);
+      // Then the timelines change: another route (or one of the agent's own), a lock, an
+      // unlock, an allocation.
+      const double draw = coin(rng);
+      if (draw < 0.4) {
+        PlanRequest other = random_request(w, rng);
+        other.agent = coin(rng) < 0.2 ? "a" : "agent" + std::to_string(change);
+        (void)w.planner.plan_and_reserve(w.timelines, other, w.next_route++);
+      } else if (draw < 0.6) {
+        if (auto lock = w.timelines.lock(e, {sec(from), sec(from + 5)}, "op", "test")) {
+          locks.push_back(lock->id);
+        }
+      } else if (draw < 0.75 && !locks.empty()) {
+        ASSERT_TRUE(w.timelines.unlock(locks.back()));
+        locks.pop_back();
+      } else {
+        for (const auto& r : w.timelines.timeline(e).reservations) {
+          if (!r.shadow()) {
+            (void)w.timelines.allocate(r.agent, e);
+            break;
+          }
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace drover::carp::test

@@ -308,6 +308,40 @@ TEST_F(TimelineTest, FreeWindowsLeaveOutOthersReservationsAndLocksOnTheConflictS
   EXPECT_EQ(set.free_windows(2, "bob", 0, kForever), windows({{0, kForever}}));
 }
 
+TEST_F(TimelineTest, NewcomerWindowsAreThoseOfAnAgentWithoutReservationsThere) {
+  ASSERT_TRUE(set.reserve("amy", 1, {at(0, 10, 20)}));
+  ASSERT_TRUE(set.lock(1, {30, 40}, "op", "spill"));
+  std::vector<Interval> out;
+  const std::uint64_t agents = set.append_newcomer_windows(0, 5, out);
+  EXPECT_EQ(out, set.free_windows(0, "bob", 5, kForever));
+  EXPECT_EQ(agents, TimelineSet::agent_bit("amy"));
+}
+
+TEST_F(TimelineTest, WindowsRevisionsMoveWhenWhatFreeWindowsReadChanges) {
+  const auto revisions = [](const TimelineSet& s) {
+    return std::vector<std::uint64_t>{s.windows_revision(0), s.windows_revision(1),
+                                      s.windows_revision(2)};
+  };
+  const auto before = revisions(set);
+  const TimelineSet copy = set;
+  EXPECT_EQ(revisions(copy), before);  // same content, same windows
+  ASSERT_TRUE(set.reserve("amy", 1, {at(0, 10, 20)}));  // real on 0, shadow on 1
+  auto after = revisions(set);
+  EXPECT_NE(after[0], before[0]);
+  EXPECT_NE(after[1], before[1]);
+  EXPECT_EQ(after[2], before[2]);
+  EXPECT_EQ(revisions(copy), before);  // the copy did not change
+  TimelineSet other = copy;
+  ASSERT_TRUE(other.reserve("bob", 1, {at(0, 50, 60)}));
+  EXPECT_NE(other.windows_revision(0), set.windows_revision(0));  // never shared by chance
+  const auto locked = set.lock(1, {30, 40}, "op", "spill");  // read by 0's windows too
+  ASSERT_TRUE(locked);
+  EXPECT_NE(set.windows_revision(0), after[0]);
+  after = revisions(set);
+  ASSERT_TRUE(set.allocate("amy", 0)->granted);  // amy's shadow on 1 is held now
+  EXPECT_NE(set.windows_revision(1), after[1]);
+}
+
 TEST_F(TimelineTest, NobodyIsPlacedBeforeAHolder) {
   ASSERT_TRUE(set.reserve("amy", 1, {at(0, 50, 60)}));
   ASSERT_TRUE(set.allocate("amy", 0)->granted);
@@ -351,6 +385,19 @@ TEST_F(TimelineTest, ALockOnAConflictingEntityBlocksThroughTheShadow) {
   ASSERT_TRUE(set.lock(1, {0, 100}, "olga", "spill"));
   EXPECT_EQ(reserve_error("amy", 1, {at(0, 10, 20)}), ErrorCode::conflict);
   EXPECT_TRUE(set.free_windows(0, "amy", 0, 200) == windows({{100, 200}}));
+}
+
+TEST_F(TimelineTest, ALockTakenInThroughAReplicatedTimelineBlocksItsConflictSetUntilReplaced) {
+  // A routing agent's replica gets its locks only through replace_timeline.
+  Timeline published;
+  published.version = 3;
+  published.locks.push_back(Lock{9, 1, {0, 100}, "olga", "spill"});
+  ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{100, 200}}));
+  published.version = 4;
+  published.locks.clear();
+  ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{0, 200}}));
 }
 
 TEST_F(TimelineTest, LockRejectsBadRequests) {

@@ -4,6 +4,7 @@
 // in timeline_query.cpp.
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <functional>
 #include <string>
@@ -49,7 +50,22 @@ void TimelineSet::Impl::sort_reservations(Timeline& timeline) {
 }
 
 void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touched) {
-  for (EntityIndex entity : touched) ++set.timelines_[entity].version;
+  const std::uint64_t revision = next_revision();
+  for (EntityIndex entity : touched) {
+    ++set.timelines_[entity].version;
+    set.revisions_.of[entity] = revision;
+  }
+}
+
+std::uint64_t TimelineSet::Impl::next_revision() {
+  static std::atomic<std::uint64_t> last{0};
+  return last.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+
+void TimelineSet::Impl::revise_around(TimelineSet& set, EntityIndex entity) {
+  const std::uint64_t revision = next_revision();
+  set.revisions_.of[entity] = revision;
+  for (EntityIndex f : set.conflict_sets_[entity]) set.revisions_.of[f] = revision;
 }
 
 bool TimelineSet::Impl::in_conflict_set(const TimelineSet& set, EntityIndex origin,
@@ -85,7 +101,8 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
     : conflict_sets_(clean_conflict_sets(std::move(conflict_sets))),
       owned_(owned_flags(std::move(owned), conflict_sets_.size())),
       timelines_(conflict_sets_.size()),
-      held_(conflict_sets_.size()) {}
+      held_(conflict_sets_.size()),
+      revisions_{std::vector<std::uint64_t>(conflict_sets_.size(), Impl::next_revision())} {}
 
 std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }
 
@@ -151,11 +168,13 @@ Result<LockReport> TimelineSet::lock(EntityIndex entity, Interval window,
     if (r.window.overlaps(window)) report.hit.push_back(r);
   }
   t.locks.push_back(Lock{report.id, entity, window, std::move(operator_id), std::move(reason)});
+  ++lock_count_;
   std::sort(t.locks.begin(), t.locks.end(), [](const Lock& a, const Lock& b) {
     return std::tie(a.window.start, a.id) < std::tie(b.window.start, b.id);
   });
   lock_entities_.emplace(report.id, entity);
   ++t.version;
+  Impl::revise_around(*this, entity);
   return report;
 }
 
@@ -165,8 +184,9 @@ Status TimelineSet::unlock(LockId id) {
     return fail(ErrorCode::not_found, "unlock: no lock with id " + std::to_string(id));
   }
   Timeline& t = timelines_[found->second];
-  std::erase_if(t.locks, [&](const Lock& lock) { return lock.id == id; });
+  lock_count_ -= std::erase_if(t.locks, [&](const Lock& lock) { return lock.id == id; });
   ++t.version;
+  Impl::revise_around(*this, found->second);
   lock_entities_.erase(found);
   return {};
 }

@@ -41,6 +41,7 @@ std::vector<Grant> TimelineSet::Impl::grant_waiting(TimelineSet& set, const Touc
       if (others_before(t, *waiting, mine->window.start) > 0) continue;
       set.held_[entity] = AllocatedStep{mine->route, mine->step};
       t.holder = *waiting;
+      revise_around(set, entity);
       grants.push_back(Grant{*waiting, entity});
       t.waiting.erase(waiting);
       touched.insert(entity);
@@ -70,6 +71,7 @@ Result<Allocation> TimelineSet::allocate(const AgentId& agent, EntityIndex entit
     t.holder = agent;
     std::erase(t.waiting, agent);
     ++t.version;
+    Impl::revise_around(*this, entity);
     return Allocation{true, 0};
   }
   // A holder's allocated reservation always comes first (nobody may be placed before
@@ -77,6 +79,7 @@ Result<Allocation> TimelineSet::allocate(const AgentId& agent, EntityIndex entit
   if (std::find(t.waiting.begin(), t.waiting.end(), agent) == t.waiting.end()) {
     t.waiting.push_back(agent);
     ++t.version;
+    Impl::revise_around(*this, entity);
   }
   return Allocation{false, ahead};
 }
@@ -109,6 +112,7 @@ Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityInde
   }
   t.holder.reset();
   held_[entity].reset();
+  Impl::revise_around(*this, entity);
   std::vector<Grant> grants = Impl::grant_waiting(*this, TouchedSet(touched), touched);
   Impl::bump_versions(*this, touched);
   return grants;

@@ -18,7 +18,19 @@ struct TimelineSet::Impl {
   /// Timeline order (see Timeline::reservations).
   static bool timeline_order(const Reservation& a, const Reservation& b);
   static void sort_reservations(Timeline& timeline);
+  /// Increments the version of every touched entity and revises its free windows (a
+  /// change of reservations changes only the windows of the timelines it touches).
   static void bump_versions(TimelineSet& set, const TouchedSet& touched);
+  /// A revision number never used before in this process.
+  static std::uint64_t next_revision();
+  /// Revises the free windows of `entity` and of the members of its conflict set, for a
+  /// change of its locks or of who holds it: their free windows read the entity's locks,
+  /// and whether the reservations standing for it (real and shadows) are held.
+  static void revise_around(TimelineSet& set, EntityIndex entity);
+  /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.
+  template <class Skip>
+  static void sweep(const TimelineSet& set, EntityIndex entity, TimeNs from, TimeNs until,
+                    std::vector<Interval>& out, bool count_locks, Skip skip);
 
   static bool in_conflict_set(const TimelineSet& set, EntityIndex origin, EntityIndex entity);
   /// True when reservations standing for origins a and b may not overlap in time if they

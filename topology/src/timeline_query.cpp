@@ -12,6 +12,7 @@
 // enough"). A held (allocated) reservation blocks from `from` on: nobody comes before it.
 
 #include <algorithm>
+#include <cstring>
 
 #include "drover/topology/timeline.hpp"
 #include "timeline_impl.hpp"
@@ -43,19 +44,20 @@ void cut_from(std::vector<Interval>& out, std::size_t base, Interval cut) {
 
 }  // namespace
 
-void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
-                                      TimeNs until, std::vector<Interval>& out,
-                                      bool count_locks) const {
-  if (!owns(entity) || from >= until) return;
+template <class Skip>
+void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, TimeNs from,
+                              TimeNs until, std::vector<Interval>& out, bool count_locks,
+                              Skip skip) {
+  if (!set.owns(entity) || from >= until) return;
   // One sweep over the reservations, which are sorted by start: a window ends where the
   // next blocker starts. Then the locks, rare, are cut out.
   const std::size_t base = out.size();
   TimeNs cursor = from;  // the end of everything blocked so far
-  for (const Reservation& r : timelines_[entity].reservations) {
-    if (same_agent(r.agent, agent)) continue;
+  for (const Reservation& r : set.timelines_[entity].reservations) {
+    if (skip(r)) continue;
     // Most reservations' origins are not held at all: that is checked first, inline.
-    if (r.window.start > from && r.origin < held_.size() && held_[r.origin] &&
-        Impl::is_held(*this, r)) {
+    if (r.window.start > from && r.origin < set.held_.size() && set.held_[r.origin] &&
+        is_held(set, r)) {
       out.resize(base);  // nobody may come before a holder
     } else if (r.window.start > cursor && cursor < until) {
       out.push_back(Interval{cursor, std::min(r.window.start, until)});
@@ -63,15 +65,46 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
     cursor = std::max(cursor, r.window.end);
   }
   if (cursor < until) out.push_back(Interval{cursor, until});
-  if (count_locks) {
+  if (count_locks && set.lock_count_ > 0) {
     const auto cut_locks = [&](EntityIndex x) {
-      for (const Lock& lock : timelines_[x].locks) cut_from(out, base, lock.window);
+      for (const Lock& lock : set.timelines_[x].locks) cut_from(out, base, lock.window);
     };
     cut_locks(entity);
-    for (EntityIndex f : conflict_sets_[entity]) {
-      if (!timelines_[f].locks.empty() && owns(f)) cut_locks(f);
+    for (EntityIndex f : set.conflict_sets_[entity]) {
+      if (!set.timelines_[f].locks.empty() && set.owns(f)) cut_locks(f);
     }
   }
+}
+
+void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
+                                      TimeNs until, std::vector<Interval>& out,
+                                      bool count_locks) const {
+  Impl::sweep(*this, entity, from, until, out, count_locks,
+              [agent](const Reservation& r) { return same_agent(r.agent, agent); });
+}
+
+std::uint64_t TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs from,
+                                                   std::vector<Interval>& out) const {
+  std::uint64_t agents = 0;
+  Impl::sweep(*this, entity, from, kForever, out, true, [&agents](const Reservation& r) {
+    agents |= agent_bit(r.agent);
+    return false;
+  });
+  return agents;
+}
+
+std::uint64_t TimelineSet::agent_bit(std::string_view agent) noexcept {
+  // Hashes the last 8 bytes and the length only: it runs for every reservation read, and
+  // fleet ids differ at their ends ("agv-017"). Two agents sharing a bit only cost a
+  // planner an exact query.
+  std::uint64_t tail = 0;
+  const std::size_t n = std::min<std::size_t>(agent.size(), sizeof tail);
+  if (n > 0) std::memcpy(&tail, agent.data() + agent.size() - n, n);
+  return std::uint64_t{1} << (((tail ^ agent.size()) * 0x9e3779b97f4a7c15ull) >> 58);
+}
+
+std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {
+  return entity < revisions_.of.size() ? revisions_.of[entity] : 0;
 }
 
 }  // namespace drover::topology

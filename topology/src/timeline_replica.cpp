@@ -18,7 +18,9 @@ Status TimelineSet::replace_timeline(EntityIndex entity, Timeline timeline) {
       held_[entity] = AllocatedStep{held->route, held->step};
     }
   }
+  lock_count_ = lock_count_ - timelines_[entity].locks.size() + timeline.locks.size();
   timelines_[entity] = std::move(timeline);
+  Impl::revise_around(*this, entity);
   return {};
 }
 

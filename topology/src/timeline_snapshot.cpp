@@ -267,11 +267,15 @@ Result<TimelineSet> TimelineSet::restore(std::vector<std::vector<EntityIndex>> c
     t.locks = es.locks;
     std::sort(t.locks.begin(), t.locks.end(), lock_order);
     for (const Lock& lock : t.locks) set.lock_entities_.emplace(lock.id, es.entity);
+    set.lock_count_ += t.locks.size();
     if (es.holding) {
       t.holder = es.holding->agent;
       set.held_[es.entity] = es.holding->step;
     }
   }
+  // Fresh revisions for every entity, after the timelines are filled in.
+  const std::uint64_t revision = Impl::next_revision();
+  for (EntityIndex e = 0; e < set.revisions_.of.size(); ++e) set.revisions_.of[e] = revision;
   set.next_lock_id_ = snapshot.next_lock_id;
   set.next_prepare_id_ = snapshot.next_prepare_id;
   return set;

@@ -234,6 +234,19 @@ class TimelineSet {
   void append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                            TimeNs until, std::vector<Interval>& out,
                            bool count_locks = true) const;
+  /// The windows append_free_windows(entity, agent, from, kForever, out) appends for an
+  /// agent with no reservation on the entity (every reservation there blocks), appended to
+  /// `out`. \return the agent_bit of every agent with a reservation there: for an agent
+  /// whose bit is clear, these are its windows.
+  std::uint64_t append_newcomer_windows(EntityIndex entity, TimeNs from,
+                                        std::vector<Interval>& out) const;
+  /// One of 64 bits, chosen by a hash of the agent id (see append_newcomer_windows).
+  static std::uint64_t agent_bit(std::string_view agent) noexcept;
+  /// Changes, to a value never returned before in this process for any set, whenever the
+  /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
+  /// allocation of a reservation's origin). Equal revisions of an entity, on this set or
+  /// on a copy of it, mean equal free windows: a planner may keep windows between plans.
+  std::uint64_t windows_revision(EntityIndex entity) const noexcept;
   /// Holds `items` (from expand) for one route, all or nothing: fails with conflict if any
   /// overlaps a lock or another agent's reservation whose origin conflicts with the
   /// item's (I1), or if an expected version moved;
@@ -394,6 +407,15 @@ class TimelineSet {
   std::vector<std::optional<AllocatedStep>> held_;  // per entity; set iff its holder is
   std::map<PrepareId, PreparedSet> prepared_;
   std::map<LockId, EntityIndex> lock_entities_;   // where each lock lives
+  // Locks on all timelines (a replica's too): without any, a free-window query need not
+  // look at the conflict set's timelines, the dearest part of it (one cache miss each).
+  std::size_t lock_count_ = 0;
+  // Per entity, see windows_revision. Not part of the state: equal sets may differ in it.
+  struct Revisions {
+    std::vector<std::uint64_t> of;
+    friend bool operator==(const Revisions&, const Revisions&) { return true; }
+  };
+  Revisions revisions_;
   std::vector<Grant> pending_grants_;             // see take_grants
   LockId next_lock_id_ = 1;
   PrepareId next_prepare_id_ = 1;
