@@ -645,7 +645,11 @@ TEST(TimelineReplica, StepHullsCloseTheGapBetweenCopiesThatOwnersMovedApart) {
   ASSERT_TRUE(replica.replace_timeline(1, one));
   EXPECT_TRUE(replica.free_windows(1, "bob", 0, 40) == windows({{0, 10}, {12, 30}, {31, 40}}));
 
+  const auto revision_of_zero = replica.windows_revision(0);
+  const auto revision_of_two = replica.windows_revision(2);
   replica.widen_to_step_hulls();
+  EXPECT_NE(replica.windows_revision(0), revision_of_zero) << "a planner must not keep the old windows";
+  EXPECT_EQ(replica.windows_revision(2), revision_of_two) << "nothing changed there";
   EXPECT_EQ(replica.timeline(0).reservations.front().window, (Interval{10, 22}));
   EXPECT_EQ(replica.timeline(1).reservations.front().window, (Interval{10, 22}));
   EXPECT_EQ(replica.timeline(1).reservations.back().window, (Interval{30, 31}));

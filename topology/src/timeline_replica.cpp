@@ -35,14 +35,17 @@ void TimelineSet::widen_to_step_hulls() {
       hull->second.end = std::max(hull->second.end, r.window.end);
     }
   }
-  for (Timeline& timeline : timelines_) {
+  for (EntityIndex entity = 0; entity < timelines_.size(); ++entity) {
+    Timeline& timeline = timelines_[entity];
     bool widened = false;
     for (Reservation& r : timeline.reservations) {
       const Interval& hull = hulls.at({r.agent, r.route, r.step});
       widened = widened || hull != r.window;
       r.window = hull;
     }
-    if (widened) Impl::sort_reservations(timeline);
+    if (!widened) continue;
+    Impl::sort_reservations(timeline);
+    revisions_.of[entity] = Impl::next_revision();  // other windows, same version
   }
 }
 

@@ -352,7 +352,8 @@ class TimelineSet {
   /// planned in the gap between them would come after the step on one entity and before
   /// it on a conflicting one, and the allocation order (I2) would deadlock both vehicles.
   /// Planned on the hulls, a new route comes before or after each step everywhere alike.
-  /// Versions are kept (prepares are checked against the published ones).
+  /// Versions are kept (prepares are checked against the published ones); the windows
+  /// revisions of widened entities change.
   void widen_to_step_hulls();
 
   // ---- persistence (timeline_snapshot.cpp) ----
