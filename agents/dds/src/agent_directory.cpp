@@ -74,7 +74,14 @@ void AgentDirectory::on_deadline_missed(const InstanceHandle_t& instance) {
 }
 
 void AgentDirectory::on_participant_event(const ParticipantEvent& event) {
-  if (event.change == ParticipantChange::discovered) return;
+  if (event.change == ParticipantChange::discovered) {
+    // A participant dropped under load (its announcements missed for a lease) and then
+    // heard again is back: its heartbeats count again. Kept among the gone, its agent
+    // stayed dead for good (a restarted topology agent ignored by every logical agent).
+    std::lock_guard lock(mutex_);
+    gone_participants_.erase(event.guid_prefix);
+    return;
+  }
   const std::string reason =
       event.change == ParticipantChange::dropped ? "participant dropped" : "participant removed";
   std::lock_guard lock(mutex_);
