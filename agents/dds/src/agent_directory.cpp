@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include <spdlog/spdlog.h>
+
 #include "drover/dds/message_types.hpp"
 
 namespace drover::dds {
@@ -54,7 +56,10 @@ AgentDirectory::~AgentDirectory() {
 void AgentDirectory::on_heartbeat(const msg::Heartbeat& beat, const fdds::SampleInfo& info) {
   const GuidPrefix_t source = info.sample_identity.writer_guid().guidPrefix;
   std::lock_guard lock(mutex_);
-  if (gone_participants_.count(source) > 0) return;  // overtaken by its participant's end
+  if (gone_participants_.count(source) > 0) {
+    spdlog::debug("directory: heartbeat of '{}' from a gone participant ignored", beat.id());
+    return;  // overtaken by its participant's end
+  }
   id_by_instance_[info.instance_handle] = beat.id();
   Entry& entry = entries_[beat.id()];
   AgentRecord record{beat.id(), beat.kind(), beat.version(), beat.owns(), beat.sim_time().ns(), true, ""};
@@ -63,7 +68,10 @@ void AgentDirectory::on_heartbeat(const msg::Heartbeat& beat, const fdds::Sample
   const bool changed = !entry.record.alive || entry.record.kind != record.kind ||
                        entry.record.version != record.version || entry.record.owns != record.owns;
   entry.record = std::move(record);
-  if (changed) publish_change_locked(entry.record);
+  if (changed) {
+    spdlog::debug("directory: '{}' ({}) alive", beat.id(), beat.kind());
+    publish_change_locked(entry.record);
+  }
 }
 
 void AgentDirectory::on_deadline_missed(const InstanceHandle_t& instance) {
@@ -74,6 +82,10 @@ void AgentDirectory::on_deadline_missed(const InstanceHandle_t& instance) {
 }
 
 void AgentDirectory::on_participant_event(const ParticipantEvent& event) {
+  spdlog::debug("directory: participant '{}' {}", event.name,
+                event.change == ParticipantChange::discovered ? "discovered"
+                : event.change == ParticipantChange::dropped  ? "dropped"
+                                                              : "removed");
   if (event.change == ParticipantChange::discovered) {
     // A participant dropped under load (its announcements missed for a lease) and then
     // heard again is back: its heartbeats count again. Kept among the gone, its agent
@@ -96,6 +108,7 @@ void AgentDirectory::mark_dead_locked(const std::string& id, const std::string& 
   if (it == entries_.end() || !it->second.record.alive) return;
   it->second.record.alive = false;
   it->second.record.lost_reason = reason;
+  spdlog::debug("directory: '{}' dead ({})", id, reason);
   publish_change_locked(it->second.record);
 }
 
