@@ -198,11 +198,17 @@ TopologyAgent::~TopologyAgent() {
   waiting_replies_.clear();
 }
 
-Result<topology::EntityIndex> TopologyAgent::owned_entity(const std::string& id) const {
+Result<topology::EntityIndex> TopologyAgent::known_entity(const std::string& id) const {
   auto entity = topology_.find(id);
   if (!entity) {
     return fail(ErrorCode::not_found, "unknown entity '" + id + "' in topology '" + topology_.name() + "'");
   }
+  return *entity;
+}
+
+Result<topology::EntityIndex> TopologyAgent::owned_entity(const std::string& id) const {
+  auto entity = known_entity(id);
+  if (!entity) return entity;
   if (!timelines_.owns(*entity)) {
     return fail(ErrorCode::not_found, "entity '" + id + "' belongs to partition '" +
                                           topology_.partition(*entity) + "', not served by topology agent '" +
@@ -347,11 +353,8 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
 void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle reply) {
   std::lock_guard lock(mutex_);
   if (request.shadows_only()) {
-    const auto origin = topology_.find(request.entity());
-    if (!origin) {
-      return send_error(reply, Error{ErrorCode::not_found, "unknown entity '" + request.entity() +
-                                                               "' in topology '" + topology_.name() + "'"});
-    }
+    const auto origin = known_entity(request.entity());
+    if (!origin) return send_error(reply, origin.error());
     auto grants = timelines_.release_shadows(request.agent(), request.route(), request.step(), *origin);
     if (!grants) return send_error(reply, grants.error());
     return send_status(reply, after_change(*grants, {}));

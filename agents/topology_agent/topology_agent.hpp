@@ -91,6 +91,8 @@ class TopologyAgent {
 
   /// The owned entity named `id`, or not_found (unknown, or of another partition).
   Result<topology::EntityIndex> owned_entity(const std::string& id) const;
+  /// The entity `id` of the topology, owned here or not. \return it, or not_found.
+  Result<topology::EntityIndex> known_entity(const std::string& id) const;
 
   void on_prepare(const msg::ReservePrepareRequest& request, dds::ReplyHandle<msg::ReservePrepareReply> reply);
   void on_commit(const msg::ReserveCommitRequest& request, StatusHandle reply);
