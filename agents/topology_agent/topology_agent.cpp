@@ -489,7 +489,7 @@ void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<
 
 void TopologyAgent::on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply) {
   std::lock_guard lock(mutex_);
-  auto grants = timelines_.cancel_route(request.agent(), request.route());
+  auto grants = timelines_.cancel_route(request.agent(), request.route(), request.held_steps());
   if (!grants) return send_error(reply, grants.error());
   std::erase_if(prepared_, [&](const auto& entry) {
     return entry.second.agent == request.agent() && entry.second.route == request.route();

@@ -198,10 +198,10 @@ TEST(TravelTime, TrapezoidAndTriangle) {
 TEST(FootprintMonitor, FootprintMustStayInsideTheHeldEntities) {
   const auto world = h_crossing();
   FootprintMonitor monitor(world);
-  monitor.hold(index(*world, "left-0"), 0);
+  monitor.hold(index(*world, "left-0"), HeldStep{1, 0});
   EXPECT_TRUE(monitor.inside(status_at(0, 0).footprint));
   EXPECT_FALSE(monitor.inside(status_at(0, 1.0, 1.5707963).footprint)) << "on the edge, not held";
-  monitor.hold(index(*world, "left-0<->left-1"), 1);
+  monitor.hold(index(*world, "left-0<->left-1"), HeldStep{1, 1});
   EXPECT_TRUE(monitor.inside(status_at(0, 1.0, 1.5707963).footprint));
   EXPECT_FALSE(monitor.inside(status_at(1.0, 1.0).footprint)) << "beside the edge";
 }
@@ -214,13 +214,13 @@ struct LeavingLeft0 : ::testing::Test {
   topology::EntityIndex edge = index(*world, "left-0<->left-1");
   topology::EntityIndex next = index(*world, "left-1");
   LeavingLeft0() {
-    monitor.hold(start, 0);
-    monitor.hold(edge, 1);
+    monitor.hold(start, HeldStep{1, 0});
+    monitor.hold(edge, HeldStep{1, 1});
   }
 };
 
 TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleNoLongerTouches) {
-  monitor.hold(next, 2);
+  monitor.hold(next, HeldStep{1, 2});
   // Still at the start: nothing to release, the edge ahead is not passed.
   EXPECT_TRUE(monitor.releasable(status_at(0, 0, 1.5707963).footprint, 0).empty());
   // Leaving, half on left-0 and half on the edge: left-0 is still needed.
@@ -231,10 +231,16 @@ TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleNoLongerTouches) {
   // Arrived at left-1: the edge is passed and no longer touched.
   EXPECT_EQ(monitor.releasable(status_at(0, 3, 1.5707963).footprint, 2), std::vector{edge});
   // Leftovers of an earlier route count as passed.
-  monitor.hold(index(*world, "bar-1"), 9);
+  monitor.hold(index(*world, "bar-1"), HeldStep{1, 9});
   monitor.forget_steps();
   const auto leftovers = monitor.releasable(status_at(0, 3, 1.5707963).footprint, 0);
   EXPECT_EQ(leftovers, (std::vector{index(*world, "bar-1"), edge})) << "ascending by entity";
+  // A leftover keeps the step it was granted as: a cancel of its route keeps that step, and
+  // its release gives up the step's shadows in other partitions.
+  EXPECT_EQ(monitor.granted_as(edge), (HeldStep{1, 1}));
+  EXPECT_EQ(monitor.held_steps_of(1), (std::vector<std::uint32_t>{1, 2, 9}));
+  EXPECT_TRUE(monitor.held_steps_of(2).empty());
+  EXPECT_FALSE(monitor.granted_as(start).has_value()) << "dropped";
 }
 
 TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleTouchesButNoLongerNeeds) {
@@ -245,7 +251,7 @@ TEST_F(LeavingLeft0, ReleasesWhatThePassedVehicleTouchesButNoLongerNeeds) {
   EXPECT_EQ(monitor.releasable(footprint, 2), std::vector{start});
   // With left-1 held, the footprint lies inside left-1's own footprint, so the edge can go
   // (a route stepping aside onto left-1 lets another vehicle use the edge meanwhile).
-  monitor.hold(next, 2);
+  monitor.hold(next, HeldStep{1, 2});
   EXPECT_EQ(monitor.releasable(footprint, 2), (std::vector{start, edge}));
   // Not passed yet: kept, however covered.
   EXPECT_EQ(monitor.releasable(footprint, 0), std::vector{start});

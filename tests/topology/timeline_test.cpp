@@ -294,6 +294,34 @@ TEST(TimelinePartition, ShadowsOfAStepReleasedByItsOwnerGoOnRequest) {
   EXPECT_TRUE(part.release_shadows("amy", 7, 3, 1)->empty()) << "repeated: no change";
 }
 
+TEST(TimelinePartition, CancelKeepsTheShadowsOfStepsStillHeldAbroad) {
+  // As above: amy's route 7 passes the neighbour's 1 as step 3 (shadow on 0 here) and
+  // goes on over 2 as step 4. Her vehicle still stands on 1 when she gives up the route.
+  TimelineSet part(graph(3, {{0, 1}}), {true, false, true});
+  auto prepared = part.prepare(
+      {Reservation{"amy", 7, 3, 0, 1, {0, 10}, false}, Reservation{"amy", 7, 4, 2, 2, {10, 20}, false}}, {}, 100);
+  ASSERT_TRUE(prepared.has_value());
+  ASSERT_TRUE(part.commit(*prepared));
+  ASSERT_TRUE(part.reserve("bob", 1, {at(0, 20, 30)}));
+
+  ASSERT_TRUE(part.cancel_route("amy", 7, {3}));
+  EXPECT_TRUE(part.timeline(2).reservations.empty()) << "the step ahead goes";
+  ASSERT_EQ(part.timeline(0).reservations.size(), 2u) << "the shadow of the held step stays";
+  EXPECT_EQ(part.timeline(0).reservations.front().agent, "amy");
+  EXPECT_FALSE(part.allocate("bob", 0)->granted) << "0 stays guarded while amy stands on 1";
+  // Her release at the owner of 1 is followed by the release of the shadows here.
+  EXPECT_EQ(*part.release_shadows("amy", 7, 3, 1), (std::vector<Grant>{Grant{"bob", 0}}));
+  // Without held steps a cancel takes the shadows with it.
+  auto again = part.prepare(
+      {Reservation{"amy", 8, 0, 2, 2, {40, 50}, false}, Reservation{"amy", 8, 1, 0, 1, {50, 60}, false}}, {}, 100);
+  ASSERT_TRUE(again.has_value());
+  ASSERT_TRUE(part.commit(*again));
+  ASSERT_TRUE(part.cancel_route("amy", 8));
+  for (EntityIndex e : {0u, 2u}) {
+    for (const auto& r : part.timeline(e).reservations) EXPECT_NE(r.route, 8u) << "on " << e;
+  }
+}
+
 // ---- free windows ---------------------------------------------------------------------
 
 TEST_F(TimelineTest, FreeWindowsLeaveOutOthersReservationsAndLocksOnTheConflictSet) {

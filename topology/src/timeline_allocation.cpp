@@ -140,7 +140,8 @@ Result<std::vector<Grant>> TimelineSet::release_shadows(const AgentId& agent, Ro
   return grants;
 }
 
-Result<std::vector<Grant>> TimelineSet::cancel_route(const AgentId& agent, RouteId route) {
+Result<std::vector<Grant>> TimelineSet::cancel_route(const AgentId& agent, RouteId route,
+                                                     const std::vector<std::uint32_t>& held_steps) {
   if (agent.empty()) return fail(ErrorCode::invalid_argument, "cancel_route: empty agent id");
   const auto of_route = [&](const Reservation& r) { return r.agent == agent && r.route == route; };
   const bool known = std::any_of(timelines_.begin(), timelines_.end(), [&](const Timeline& t) {
@@ -152,8 +153,12 @@ Result<std::vector<Grant>> TimelineSet::cancel_route(const AgentId& agent, Route
   }
   TouchedSet touched;
   // Decide with the allocation state before anything is removed.
+  const auto held_abroad = [&](const Reservation& r) {
+    return !owns(r.origin) && std::find(held_steps.begin(), held_steps.end(), r.step) != held_steps.end();
+  };
   Impl::remove_reservations(
-      *this, [&](const Reservation& r) { return of_route(r) && !Impl::is_held(*this, r); },
+      *this,
+      [&](const Reservation& r) { return of_route(r) && !Impl::is_held(*this, r) && !held_abroad(r); },
       touched);
   std::erase_if(prepared_, [&](const auto& entry) {
     return entry.second.agent == agent && entry.second.route == route;

@@ -101,7 +101,8 @@ void LogicalAgent::run() {
   // reservations go; what the vehicle occupies stays allocated.
   stop_vehicle();
   if (route_) {
-    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id()); !cancelled) {
+    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id(), monitor_.held_steps_of(route_->id()));
+        !cancelled) {
       spdlog::warn("route {} not cancelled on shutdown: {}", route_->id(), cancelled.error().message);
     } else {
       spdlog::info("route {} cancelled on shutdown", route_->id());
@@ -262,7 +263,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   // route's first step (nobody can come between: the new reservation starts now and the
   // old one held the vertex since the vehicle arrived).
   if (monitor_.holds(here)) {
-    if (auto released = services_->release(vehicle_id(), here, held_step(here)); !released) return released;
+    if (auto released = services_->release(vehicle_id(), here, monitor_.granted_as(here)); !released) return released;
     monitor_.drop(here);
   }
   for (;;) {
@@ -281,7 +282,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     make_way_.reset();  // the vehicle leaves anyway
   }
   monitor_.forget_steps();
-  monitor_.hold(here, 0);
+  monitor_.hold(here, HeldStep{next.id(), 0});
   next.mark_allocated();
   route_ = std::move(next);
   pending_moves_.clear();
@@ -393,7 +394,7 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
           break;
         }
         if (!outcome->granted) break;
-        monitor_.hold(entity, *next);
+        monitor_.hold(entity, HeldStep{route_->id(), static_cast<std::uint32_t>(*next)});
         route_->mark_allocated();
       }
       // Moves up to the last allocated vertex.
@@ -421,18 +422,12 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
 
 void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
   for (const auto entity : monitor_.releasable(status.footprint, route_ ? route_->reached() : 0)) {
-    if (auto released = services_->release(vehicle_id(), entity, held_step(entity)); !released) {
+    if (auto released = services_->release(vehicle_id(), entity, monitor_.granted_as(entity)); !released) {
       spdlog::warn("release of '{}' failed: {}", topology_->id(entity), released.error().message);
       continue;
     }
     monitor_.drop(entity);
   }
-}
-
-std::optional<HeldStep> LogicalAgent::held_step(topology::EntityIndex entity) const {
-  const auto step = monitor_.step_of(entity);
-  if (!step || !route_) return std::nullopt;
-  return HeldStep{route_->id(), static_cast<std::uint32_t>(*step)};
 }
 
 std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& status) {
@@ -567,7 +562,7 @@ void LogicalAgent::stop_vehicle() {
 }
 
 void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
-  if (auto cancelled = services_->cancel_route(vehicle_id(), route); !cancelled) {
+  if (auto cancelled = services_->cancel_route(vehicle_id(), route, monitor_.held_steps_of(route)); !cancelled) {
     spdlog::warn("route {} not cancelled: {}", route, cancelled.error().message);
   }
 }
@@ -579,7 +574,7 @@ void LogicalAgent::abandon_route() {
   monitor_.forget_steps();
   if (const auto status = latest_status()) {
     for (const auto entity : monitor_.releasable(status->footprint, 0)) {
-      if (services_->release(vehicle_id(), entity, std::nullopt)) monitor_.drop(entity);
+      if (services_->release(vehicle_id(), entity, monitor_.granted_as(entity))) monitor_.drop(entity);
     }
   }
   route_.reset();

@@ -4,6 +4,7 @@
 // touches, and which the vehicle has passed, is to be released.
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -11,27 +12,34 @@
 
 #include "drover/ran/commands.hpp"
 #include "drover/topology/model.hpp"
+#include "drover/topology/timeline.hpp"
 
 namespace drover::logical_agent {
+
+/// The route step an allocation was granted as.
+struct HeldStep {
+  topology::RouteId route = 0;
+  std::uint32_t step = 0;
+  friend bool operator==(const HeldStep&, const HeldStep&) = default;
+};
 
 class FootprintMonitor {
  public:
   /// \param tolerance_m2  how much of the footprint may lie outside (round-off).
   FootprintMonitor(std::shared_ptr<const topology::Topology> topology, double tolerance_m2 = 1e-3);
 
-  /// The vehicle holds `entity` as step `step` of its current route; nullopt: a leftover of
-  /// an earlier route (behind the vehicle whatever its step).
-  void hold(topology::EntityIndex entity, std::optional<std::size_t> step);
+  /// The vehicle holds `entity`, granted as `granted_as`, a step of its current route.
+  void hold(topology::EntityIndex entity, HeldStep granted_as);
   void drop(topology::EntityIndex entity);
-  /// Marks every held entity a leftover of an earlier route (a new route begins).
+  /// Marks every held entity a leftover of an earlier route (a new route begins): behind
+  /// the vehicle whatever its step.
   void forget_steps();
   bool holds(topology::EntityIndex entity) const { return held_.count(entity) != 0; }
-  /// The current route's step `entity` is held as; nullopt for a leftover or an entity
-  /// not held.
-  std::optional<std::size_t> step_of(topology::EntityIndex entity) const {
-    const auto found = held_.find(entity);
-    return found == held_.end() ? std::nullopt : found->second;
-  }
+  /// The route step `entity` was granted as (of the current route or an earlier one);
+  /// nullopt when not held. Its release gives up that step's shadows too.
+  std::optional<HeldStep> granted_as(topology::EntityIndex entity) const;
+  /// The steps of `route` still held, ascending (what a cancel of the route must keep).
+  std::vector<std::uint32_t> held_steps_of(topology::RouteId route) const;
   std::vector<topology::EntityIndex> held() const;
 
   /// Area (m^2) of `footprint` outside the union of the held entities' footprints.
@@ -56,7 +64,11 @@ class FootprintMonitor {
 
   std::shared_ptr<const topology::Topology> topology_;
   double tolerance_m2_;
-  std::map<topology::EntityIndex, std::optional<std::size_t>> held_;
+  struct Holding {
+    HeldStep granted_as;
+    bool current_route = true;  ///< false: a leftover of an earlier route
+  };
+  std::map<topology::EntityIndex, Holding> held_;
   mutable std::optional<ran::MotionArea> area_;  ///< normalized union, rebuilt on demand
 };
 

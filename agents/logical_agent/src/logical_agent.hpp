@@ -155,8 +155,6 @@ class LogicalAgent {
   /// Cancels a route of ours on every topology agent; failures are logged.
   void cancel_route_quietly(topology::RouteId route);
   void release_passed(const ran::VehicleStatus& status);
-  /// The current route's step the allocation of `entity` belongs to (nullopt: a leftover).
-  std::optional<HeldStep> held_step(topology::EntityIndex entity) const;
   void process_notices(bool& replan);
   void propagate_delay(std::size_t from_step, DurationNs by);
   void stop_vehicle();

@@ -164,20 +164,16 @@ Result<std::vector<topology::Shift>> TopologyServices::delay(const std::string& 
   });
 }
 
-Status TopologyServices::cancel_route(const std::string& agent, topology::RouteId route) {
+Status TopologyServices::cancel_route(const std::string& agent, topology::RouteId route,
+                                      const std::vector<std::uint32_t>& held_steps) {
   for (const auto& partition : topology_->partitions()) {
     auto done = retry<bool>([&]() -> Result<bool> {
-      std::optional<std::string> owner;
-      for (const auto& record : directory_->live_agents()) {
-        if (record.kind == "topology" &&
-            std::find(record.owns.begin(), record.owns.end(), partition) != record.owns.end()) {
-          owner = record.id;
-        }
-      }
-      if (!owner) return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "'");
+      auto owner = owner_of_partition(partition);
+      if (!owner) return unexpected(owner.error());
       msg::CancelRouteRequest request;
       request.agent(agent);
       request.route(route);
+      request.held_steps(held_steps);
       auto reply = cancel_client_->call(request, call_timeout_, *owner);
       if (!reply) return unexpected(reply.error());
       if (auto status = dds::from_wire(reply->error()); !status && status.error().code != ErrorCode::not_found) {

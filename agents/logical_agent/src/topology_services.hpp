@@ -15,6 +15,7 @@
 #include "drover/dds/agent_directory.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/service_client.hpp"
+#include "agents/logical_agent/src/footprint_monitor.hpp"
 #include "drover/topology/model.hpp"
 #include "drover/topology/timeline.hpp"
 #include "routing.h"
@@ -25,12 +26,6 @@ namespace drover::logical_agent {
 struct AllocateOutcome {
   bool granted = false;
   std::size_t queue_position = 0;
-};
-
-/// The route step an allocation was granted as.
-struct HeldStep {
-  topology::RouteId route = 0;
-  std::uint32_t step = 0;
 };
 
 /// Thread-safe. Must be destroyed before its Participant.
@@ -62,8 +57,10 @@ class TopologyServices {
   Result<std::vector<topology::Shift>> delay(const std::string& agent, topology::RouteId route,
                                              topology::EntityIndex entity, DurationNs by);
   /// Cancels `route` on every live topology agent (not_found there is fine), retrying the
-  /// ones that do not answer. \return success, or the first other error.
-  Status cancel_route(const std::string& agent, topology::RouteId route);
+  /// ones that do not answer. The route's `held_steps` (allocations the vehicle still
+  /// stands on) stay with their shadows in every partition, to go with their release.
+  /// \return success, or the first other error.
+  Status cancel_route(const std::string& agent, topology::RouteId route, const std::vector<std::uint32_t>& held_steps);
 
   /// The live topology agent owning `entity`. \return its id, or unavailable.
   Result<std::string> owner_of(topology::EntityIndex entity) const;

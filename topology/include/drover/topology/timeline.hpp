@@ -308,9 +308,13 @@ class TimelineSet {
 
   /// Removes every reservation of (agent, route) that is not allocated, with shadows, also
   /// held (prepared) ones, whose prepared sets are dropped; withdraws the agent's waiting
-  /// requests where no committed reservation of it is left. not_found if the route has
-  /// nothing here. \return the waiting requests this made grantable (now granted), by entity.
-  Result<std::vector<Grant>> cancel_route(const AgentId& agent, RouteId route);
+  /// requests where no committed reservation of it is left. `held_steps`: steps of the
+  /// route the agent holds in another partition (its vehicle stands there); their shadows
+  /// here stay until release_shadows, so that a conflicting entity across the border stays
+  /// guarded. not_found if the route has nothing here.
+  /// \return the waiting requests this made grantable (now granted), by entity.
+  Result<std::vector<Grant>> cancel_route(const AgentId& agent, RouteId route,
+                                          const std::vector<std::uint32_t>& held_steps = {});
 
   /// Delay of `by` (> 0) for `agent`'s route from its step on `entity` on: that step's
   /// window ends `by` later and the later steps move by `by`; every later reservation of
