@@ -1,5 +1,6 @@
 // Heartbeats and the agent directory over real processes, and clean shutdown on signals.
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <mutex>
@@ -91,6 +92,36 @@ TEST_F(AgentDirectoryTest, NoticesADroppedParticipantWithoutTheDeadline) {
   peers_.front().signal(SIGKILL);
   ASSERT_TRUE((*directory)->wait_for_agent("logical-9", false, kDeathBound));
   EXPECT_EQ((*directory)->find("logical-9")->lost_reason, "participant dropped");
+}
+
+TEST_F(AgentDirectoryTest, SeesAnAgentKilledAndRestartedAgainAndAgain) {
+  // A crashed agent comes back in a new process at once, while its old participant is
+  // still announced (the launcher restarts it so): the new process's heartbeats must reach
+  // the directory every time.
+  constexpr std::uint32_t kDomain = 22;
+  auto participant = make_participant(kDomain, "observer");
+  ASSERT_NE(participant, nullptr);
+  dds::AgentDirectoryOptions options;
+  options.deadline = std::chrono::milliseconds(120000);  // only the participant's drop tells
+  auto directory = dds::AgentDirectory::create(*participant, options);
+  ASSERT_TRUE(directory.has_value()) << directory.error().message;
+  for (int life = 0; life < 6; ++life) {
+    // Each life says which it is in what it owns.
+    const std::string mark = "life-" + std::to_string(life);
+    auto peer = spawn_peer(kDomain, "phoenix", {"--heartbeat", "topology", "--owns", mark});
+    ASSERT_TRUE(peer.has_value());
+    peers_.push_back(std::move(*peer));
+    const bool seen = (*directory)->wait_until(
+        [&](const std::vector<dds::AgentRecord>& records) {
+          return std::any_of(records.begin(), records.end(), [&](const dds::AgentRecord& r) {
+            return r.id == "phoenix" && r.alive && r.owns == std::vector<std::string>{mark};
+          });
+        },
+        kDiscoveryTimeout);
+    ASSERT_TRUE(seen) << "life " << life << " of the agent was never seen";
+    peers_.back().signal(SIGKILL);
+    ASSERT_TRUE(peers_.back().wait_exit(kDiscoveryTimeout).has_value());
+  }
 }
 
 /// A peer asked to stop by `signal_number` deletes its entities and exits 0; the

@@ -604,6 +604,38 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheRoutingAgent) {
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
 }
 
+TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
+  constexpr std::uint32_t kDomain = 83;
+  Fleet fleet(kDomain, "topology-restart");
+  // The topology agent keeps its reservations in a journal, so its next life goes on
+  // with the routes the vehicles are driving.
+  fleet.start_infrastructure("topology.db");
+  watch(kDomain, fleet, {"V1", "V2"});
+  fleet.start_vehicle("V1", "left-0");
+  fleet.start_vehicle("V2", "right-0");
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_EQ(send_order("V1", "v1-there", {{"right-4", "NOP"}}), "");
+  ASSERT_EQ(send_order("V2", "v2-there", {{"left-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  fleet.crash_and_restart("topology");
+
+  const auto first = wait_order("v1-there");
+  const auto second = wait_order("v2-there");
+  ASSERT_TRUE(first && second) << "an order did not end";
+  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
+  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
+  // A new route is reserved and allocated at the restarted topology agent.
+  ASSERT_EQ(send_order("V1", "v1-back", {{"left-0", "NOP"}}), "");
+  const auto back = wait_order("v1-back");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   constexpr std::uint32_t kDomain = 90;
   Fleet fleet(kDomain, "drift");

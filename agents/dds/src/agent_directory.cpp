@@ -63,6 +63,7 @@ void AgentDirectory::on_heartbeat(const msg::Heartbeat& beat, const fdds::Sample
   id_by_instance_[info.instance_handle] = beat.id();
   Entry& entry = entries_[beat.id()];
   AgentRecord record{beat.id(), beat.kind(), beat.version(), beat.owns(), beat.sim_time().ns(), true, ""};
+  if (entry.participant != source) spdlog::debug("directory: heartbeat of '{}' from a new participant", beat.id());
   entry.participant = source;
   // Only the sim_time changes with every beat: changes of anything else are announced.
   const bool changed = !entry.record.alive || entry.record.kind != record.kind ||

@@ -2,12 +2,14 @@
 
 #include <cctype>
 #include <filesystem>
+#include <memory>
 #include <utility>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/participant/ParticipantDiscoveryInfo.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <spdlog/spdlog.h>
 
 #include "drover/dds/detail/requester_filter.hpp"
@@ -81,6 +83,16 @@ Result<fdds::DomainParticipantQos> participant_qos(const ParticipantOptions& opt
                 "no DDS participant profile named '" + options.profile_name + "'");
   }
   qos.name(options.agent_id);
+  if (options.xml_profile_file.empty() && qos.transport().use_builtin_transports &&
+      qos.transport().user_transports.empty()) {
+    // UDPv4 only, not Fast DDS's default of shared memory + UDP: 2.9's shared-memory
+    // transport loses the traffic to a process restarted after a crash that gets its
+    // predecessor's port (it replaces the dead port's segment while the others keep
+    // writing into the old one), so nobody heard a restarted topology agent again. An XML
+    // profile file sets the transports as it likes.
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+  }
   auto& discovery = qos.wire_protocol().builtin.discovery_config;
   discovery.leaseDuration = to_duration(options.lease_duration);
   discovery.leaseDuration_announcementperiod = to_duration(options.announcement_period);

@@ -95,6 +95,8 @@ void ReaderCore::on_subscription_matched(fdds::DataReader*,
     std::lock_guard lock(match_mutex_);
     matched_.update(status.last_publication_handle, status.current_count_change);
   }
+  spdlog::debug("reader on '{}': {} writer(s) matched ({:+})", spec_.topic, status.current_count,
+                status.current_count_change);
   match_changed_.notify_all();
   if (on_match_) on_match_();
 }
