@@ -400,6 +400,18 @@ class FleetTest : public ::testing::Test {
     ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
   }
 
+  /// The crossing's usual start: infrastructure (the topology agent journaling to `journal`
+  /// when given), V1 on left-0 and V2 on right-0, both ready. Call through
+  /// ASSERT_NO_FATAL_FAILURE.
+  void start_two_vehicles(Fleet& fleet, std::uint32_t domain, const std::string& journal = {}) {
+    fleet.start_infrastructure(journal);
+    watch(domain, fleet, {"V1", "V2"});
+    fleet.start_vehicle("V1", "left-0");
+    fleet.start_vehicle("V2", "right-0");
+    ASSERT_TRUE(wait_ready("V1", "left-0"));
+    ASSERT_TRUE(wait_ready("V2", "right-0"));
+  }
+
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
   bool wait_ready(const std::string& vehicle, const std::string& vertex) {
     return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
@@ -420,12 +432,7 @@ class FleetTest : public ::testing::Test {
 TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
   constexpr std::uint32_t kDomain = 86;
   Fleet fleet(kDomain, "crossing");
-  fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1", "V2"});
-  fleet.start_vehicle("V1", "left-0");
-  fleet.start_vehicle("V2", "right-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
 
   // V1 through droverctl, as an operator would; V2 directly.
   auto droverctl = ChildProcess::spawn(binary_path("droverctl"),
@@ -465,12 +472,7 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
 TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   constexpr std::uint32_t kDomain = 87;
   Fleet fleet(kDomain, "stall");
-  fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1", "V2"});
-  fleet.start_vehicle("V1", "left-0");
-  fleet.start_vehicle("V2", "right-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
   ASSERT_EQ(send_order("V1", "v1-stall", {{"right-4", "NOP"}}), "");
   // V2's order only once V1 drives (its route is reserved): V1 is then first on the bar.
   ASSERT_TRUE(seen_.wait(
@@ -573,12 +575,7 @@ TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
 TEST_F(FleetTest, OrdersSurviveACrashOfTheRoutingAgent) {
   constexpr std::uint32_t kDomain = 89;
   Fleet fleet(kDomain, "restart");
-  fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1", "V2"});
-  fleet.start_vehicle("V1", "left-0");
-  fleet.start_vehicle("V2", "right-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
   ASSERT_EQ(send_order("V1", "v1-there", {{"right-4", "NOP"}}), "");
   ASSERT_EQ(send_order("V2", "v2-there", {{"left-4", "NOP"}}), "");
   // Both drive (their routes are reserved and allocated in part): the routing agent crashes
@@ -608,12 +605,7 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
   Fleet fleet(kDomain, "topology-restart");
   // The topology agent keeps its reservations in a journal, so its next life goes on
   // with the routes the vehicles are driving.
-  fleet.start_infrastructure("topology.db");
-  watch(kDomain, fleet, {"V1", "V2"});
-  fleet.start_vehicle("V1", "left-0");
-  fleet.start_vehicle("V2", "right-0");
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_TRUE(wait_ready("V2", "right-0"));
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain, "topology.db"));
   ASSERT_EQ(send_order("V1", "v1-there", {{"right-4", "NOP"}}), "");
   ASSERT_EQ(send_order("V2", "v2-there", {{"left-4", "NOP"}}), "");
   ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";

@@ -37,6 +37,11 @@ fdds::DataWriterQos writer_qos(const TopicQos& qos) {
   // A blocked reliable writer (history full of unacknowledged samples) waits this long
   // before write() fails, instead of the default 100 ms.
   out.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(1, 0);
+  // A sample lost on the wire (a UDP receive buffer overflowing on a loaded host) is sent
+  // again once a reader's answer to the writer's heartbeat asks for it. Fast DDS's default
+  // heartbeat period is 3 s, as long as a service call's timeout: a lost reply made a
+  // reservation commit time out. Heartbeats go only while samples are unacknowledged.
+  out.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100'000'000);
   return out;
 }
 
