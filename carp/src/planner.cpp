@@ -155,6 +155,7 @@ struct Planner::Impl {
       return error(PlanFailure::invalid_request, std::move(message));
     };
     if (options.horizon <= 0) return invalid("the planner's horizon must be > 0");
+    if (options.floor_proof_after == 0) return invalid("the planner's floor_proof_after must be >= 1");
     if (request.agent.empty()) return invalid("the agent id is empty");
     if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
     if (timelines.entity_count() != topology().entity_count()) {
@@ -342,6 +343,7 @@ struct Planner::Impl {
     input.start_time = request.start_time;
     input.legs = legs;
     input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
+    input.floor_proof_after = options.floor_proof_after;
     const SearchOutcome outcome = search.run(input);
     if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));
     return search.route(input);
