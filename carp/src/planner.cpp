@@ -141,6 +141,7 @@ struct Planner::Impl {
   std::vector<Leg> legs;
   std::vector<Interval> goal_windows;
   FreePathSearch free_paths;  ///< only to name the blockers of a failed search
+  PlanStats stats;            ///< of the last plan's search
 
   Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
       : graph(std::move(g)), options(o), heuristics(o.heuristic_tables), free_paths(graph) {}
@@ -156,6 +157,7 @@ struct Planner::Impl {
     };
     if (options.horizon <= 0) return invalid("the planner's horizon must be > 0");
     if (options.floor_proof_after == 0) return invalid("the planner's floor_proof_after must be >= 1");
+    if (options.floor_proof_budget == 0) return invalid("the planner's floor_proof_budget must be >= 1");
     if (request.agent.empty()) return invalid("the agent id is empty");
     if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
     if (timelines.entity_count() != topology().entity_count()) {
@@ -327,6 +329,7 @@ struct Planner::Impl {
   }
 
   Result<Route, PlanError> plan(const TimelineSet& timelines, const PlanRequest& request) {
+    stats = PlanStats{};
     if (auto bad = check_request(timelines, request)) return unexpected(std::move(*bad));
     const auto [traversal, class_id] = traversals.get(*graph, request.vehicle);
     if (auto bad = check_usable(*traversal, request)) return unexpected(std::move(*bad));
@@ -344,7 +347,9 @@ struct Planner::Impl {
     input.legs = legs;
     input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
     input.floor_proof_after = options.floor_proof_after;
+    input.floor_proof_budget = options.floor_proof_budget;
     const SearchOutcome outcome = search.run(input);
+    stats = search.stats();
     if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));
     return search.route(input);
   }
@@ -357,6 +362,8 @@ Planner::Planner(Planner&&) noexcept = default;
 Planner& Planner::operator=(Planner&&) noexcept = default;
 
 const RoutingGraph& Planner::graph() const noexcept { return *impl_->graph; }
+
+const PlanStats& Planner::last_stats() const noexcept { return impl_->stats; }
 
 Result<Route, PlanError> Planner::plan(const TimelineSet& timelines, const PlanRequest& request) {
   return impl_->plan(timelines, request);

@@ -11,11 +11,12 @@ namespace {
 
 /// How many times a search raises the arrival floor in a row (each by one proof). Once a
 /// search has expanded input.floor_proof_after states keyed by the floor, it tries to prove
-/// the floor too early (prove_late) with a budget of as many backward states; if that fails,
-/// it tries again at four times as many with four times the budget, so the proofs cost at
-/// most about half the expansions. A floor one step below the arrival can cost tens of
-/// thousands of expansions (warehouse N = 400: 12 000 for an agent that needs 60 with the
-/// exact floor), while most searches expand only a few hundred states and never try.
+/// the floor too early (prove_late) with a budget of input.floor_proof_budget backward
+/// states (by default as many); if that fails, it tries again at four times as many with
+/// four times the budget, so the proofs cost at most about half the expansions. A floor
+/// one step below the arrival can cost tens of thousands of expansions (warehouse N = 400:
+/// 12 000 for an agent that needs 60 with the exact floor), while most searches expand only
+/// a few hundred states and never try.
 constexpr int kLateProofRounds = 8;
 
 }  // namespace
@@ -47,9 +48,12 @@ void WindowSearch::begin(const SearchInput& input) {
   open_.clear();
   sequence_ = 0;
   goal_state_ = kNone;
+  arrival_floor_ = 0;
   floor_pops_ = 0;
   next_proof_at_ = input.floor_proof_after;
-  proof_budget_ = input.floor_proof_after;
+  proof_budget_ = input.floor_proof_budget;
+  floor_proofs_ = 0;
+  floor_raises_ = 0;
 }
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
@@ -169,8 +173,13 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
   const TimeNs floor = arrival_floor_;
   for (int round = 0; round < kLateProofRounds; ++round) {
     const LateProof proof = prove_late(input, arrival_floor_, proof_budget_);
+    ++floor_proofs_;
     if (!proof.proven) break;
-    if (proof.margin == kForever) return false;
+    ++floor_raises_;
+    if (proof.margin == kForever) {
+      arrival_floor_ = kForever;
+      return false;
+    }
     arrival_floor_ += proof.margin;
   }
   if (arrival_floor_ == floor) {
@@ -186,6 +195,34 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
   return true;
 }
 
+// Why a proof is sound (reviewed 2026-11-25). Take any route of the forward model (drive)
+// arriving by deadline + d, 0 <= d < margin: states s_0 (the start state) ... s_n (the
+// stop's open-ended window), ready at r_i. Backwards from s_n, every s_i is reached with a
+// final label (latest, cap) such that latest >= r_i - d and cap >= r_i:
+// - s_n: latest = deadline >= r_n - d, cap = kForever.
+// - Step from s_(i+1) over arc a, edge window e, window W of s_i, onto the edge at y: the
+//   route has max(r_i, e.start) <= y <= min(r_(i+1), e.end - clearance) - travel,
+//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + lower_bound (the
+//   straight-line bound is consistent with travel()). So the checks that do not depend on
+//   the deadline (`continue` without fails_by) pass; the label side of the others is
+//   >= y - d (latest) and >= y (cap): the edge check's top.latest - travel, and
+//   latest_onto_edge, are >= y - d; the window and straight-line checks' label >= r_i - d.
+//   Had one failed, it would have recorded a gap <= d < margin (its cap reaches the fixed
+//   time, so it counts). The breaks skip only windows that start later (larger gaps). So
+//   s_i is reached with latest >= min(y - d, W.end - clearance) >= r_i - d and cap >= r_i.
+//   Labels keep the max of `latest` and of `cap` separately (an over-approximation), and a
+//   label that grows is expanded again, so the checks are made with the final label too.
+// - At the route's last visit to the start window (it could as well have waited there from
+//   the start time), the start check either returned "not proven" or recorded
+//   start_time - latest <= d. Contradiction: no route arrives by deadline + d.
+// (Before the search: no arrival precedes the open-ended window's start, hence that margin.)
+// The horizon and the heuristic's unreachable vertices are not checked (a relaxation: a
+// proof only gets rarer); usable_vertex(from) holds for every vertex a route leaves (an arc
+// needs a usable destination, check_usable the start). Every gap is > 0, so the floor
+// rises strictly. It stays a lower bound of every arrival, so the keys
+// max(ready + h, floor) stay admissible, improve() reopens closed states, and the first
+// completed state popped is the earliest arrival. planner_random_test checks the final
+// floor itself against the brute force.
 WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeNs deadline,
                                                  std::size_t budget) {
   const RoutingGraph& graph = *input.graph;

@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "drover/carp/planner.hpp"
 #include "drover/carp/route.hpp"
 #include "heuristic.hpp"
 #include "min_heap.hpp"
@@ -43,7 +44,8 @@ struct SearchInput {
   std::span<const Leg> legs;
   TimeNs deadline = 0;         ///< states that could only leave later are dropped
   bool count_locks = true;
-  std::size_t floor_proof_after = 256;  ///< PlannerOptions::floor_proof_after
+  std::size_t floor_proof_after = 256;   ///< PlannerOptions::floor_proof_after
+  std::size_t floor_proof_budget = 256;  ///< PlannerOptions::floor_proof_budget
 };
 
 struct SearchOutcome {
@@ -57,6 +59,10 @@ class WindowSearch {
   SearchOutcome run(const SearchInput& input);
   /// The route found by the last run(). \pre it found one
   Route route(const SearchInput& input) const;
+  /// What the last run() did.
+  PlanStats stats() const {
+    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_};
+  }
 
  private:
   struct State {
@@ -210,6 +216,8 @@ class WindowSearch {
   std::size_t floor_pops_ = 0;     // states expanded with the floor as key, since it last rose
   std::size_t next_proof_at_ = 0;  // floor_pops_ at which raise_arrival_floor is tried
   std::size_t proof_budget_ = 0;   // backward states prove_late may visit
+  std::size_t floor_proofs_ = 0;   // prove_late calls in this search
+  std::size_t floor_raises_ = 0;   // of which proven
   std::uint32_t goal_state_ = kNone;
 };
 
