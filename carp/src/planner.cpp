@@ -102,14 +102,6 @@ void sort_unique(std::vector<std::string>& names) {
   names.erase(std::unique(names.begin(), names.end()), names.end());
 }
 
-/// True when any entity has a lock (else a search without locks would find nothing new).
-bool any_lock(const TimelineSet& timelines) {
-  for (EntityIndex e = 0; e < timelines.entity_count(); ++e) {
-    if (timelines.owns(e) && !timelines.timeline(e).locks.empty()) return true;
-  }
-  return false;
-}
-
 /// True when some path leads from `from` to `to`, whatever the vehicle.
 bool connected(const RoutingGraph& graph, EntityIndex from, EntityIndex to) {
   std::vector<std::uint8_t> seen(graph.vertex_count(), 0);
@@ -305,7 +297,8 @@ struct Planner::Impl {
     }
     const EntityIndex goal = request.stops.back().vertex;
     input.count_locks = false;
-    if (any_lock(timelines) && search.run(input).found) {
+    // Without any lock, a search without locks would find nothing new.
+    if (timelines.lock_count() > 0 && search.run(input).found) {
       return error(PlanFailure::locked,
                    fmt::format("locks block every route to {}; without them it would arrive "
                                "at {}",
