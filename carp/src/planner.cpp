@@ -102,14 +102,6 @@ void sort_unique(std::vector<std::string>& names) {
   names.erase(std::unique(names.begin(), names.end()), names.end());
 }
 
-/// True when any entity has a lock (else a search without locks would find nothing new).
-bool any_lock(const TimelineSet& timelines) {
-  for (EntityIndex e = 0; e < timelines.entity_count(); ++e) {
-    if (timelines.owns(e) && !timelines.timeline(e).locks.empty()) return true;
-  }
-  return false;
-}
-
 /// True when some path leads from `from` to `to`, whatever the vehicle.
 bool connected(const RoutingGraph& graph, EntityIndex from, EntityIndex to) {
   std::vector<std::uint8_t> seen(graph.vertex_count(), 0);
@@ -140,7 +132,9 @@ struct Planner::Impl {
   WindowSearch search;
   std::vector<Leg> legs;
   std::vector<Interval> goal_windows;
+  std::vector<Interval> start_windows;
   FreePathSearch free_paths;  ///< only to name the blockers of a failed search
+  PlanStats stats;            ///< of the last plan's search
 
   Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
       : graph(std::move(g)), options(o), heuristics(o.heuristic_tables), free_paths(graph) {}
@@ -155,6 +149,8 @@ struct Planner::Impl {
       return error(PlanFailure::invalid_request, std::move(message));
     };
     if (options.horizon <= 0) return invalid("the planner's horizon must be > 0");
+    if (options.floor_proof_after == 0) return invalid("the planner's floor_proof_after must be >= 1");
+    if (options.floor_proof_budget == 0) return invalid("the planner's floor_proof_budget must be >= 1");
     if (request.agent.empty()) return invalid("the agent id is empty");
     if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
     if (timelines.entity_count() != topology().entity_count()) {
@@ -286,23 +282,47 @@ struct Planner::Impl {
     return blockers;
   }
 
+  /// True when the search could start: a free window of the start vertex begins at the
+  /// start time (the search's own test, on the same query).
+  bool start_free(const TimelineSet& timelines, const PlanRequest& request) {
+    start_windows.clear();
+    timelines.append_free_windows(request.start, request.agent, request.start_time, kForever,
+                                  start_windows);
+    return !start_windows.empty() && start_windows.front().start == request.start_time;
+  }
+
+  /// True when every leg's stop is reachable from where the leg starts (prepare_legs would
+  /// find a reservation-free time for each); false when that is not known.
+  bool legs_reachable(const Traversal& traversal, const PlanRequest& request) const {
+    EntityIndex from = request.start;
+    for (const Stop& stop : request.stops) {
+      if (!traversal.mutually_reachable(*graph, from, stop.vertex)) return false;
+      from = stop.vertex;
+    }
+    return true;
+  }
+
+  /// Why the start vertex is not free at the start time.
+  PlanError blocked_start(const TimelineSet& timelines, const PlanRequest& request) const {
+    const std::string& agent = request.agent;
+    std::vector<Interval> without_locks;
+    timelines.append_free_windows(request.start, agent, request.start_time,
+                                  request.start_time + 1, without_locks, false);
+    const std::string why = blocker_text(topology(), timelines, request.start, agent,
+                                         request.start_time);
+    return error(without_locks.empty() ? PlanFailure::no_window : PlanFailure::locked,
+                 fmt::format("start vertex {} is not free at {}: {}",
+                             vertex_name(request.start), time_text(request.start_time), why));
+  }
+
   /// Explains a search that found nothing (only called then, so it may take its time).
   PlanError diagnose(const TimelineSet& timelines, const PlanRequest& request,
                      SearchInput input, const SearchOutcome& outcome) {
-    const std::string& agent = request.agent;
-    std::vector<Interval> without_locks;
-    if (!outcome.start_free) {
-      timelines.append_free_windows(request.start, agent, request.start_time,
-                                    request.start_time + 1, without_locks, false);
-      const std::string why = blocker_text(topology(), timelines, request.start, agent,
-                                           request.start_time);
-      return error(without_locks.empty() ? PlanFailure::no_window : PlanFailure::locked,
-                   fmt::format("start vertex {} is not free at {}: {}",
-                               vertex_name(request.start), time_text(request.start_time), why));
-    }
+    if (!outcome.start_free) return blocked_start(timelines, request);
     const EntityIndex goal = request.stops.back().vertex;
     input.count_locks = false;
-    if (any_lock(timelines) && search.run(input).found) {
+    // Without any lock, a search without locks would find nothing new.
+    if (timelines.lock_count() > 0 && search.run(input).found) {
       return error(PlanFailure::locked,
                    fmt::format("locks block every route to {}; without them it would arrive "
                                "at {}",
@@ -326,9 +346,18 @@ struct Planner::Impl {
   }
 
   Result<Route, PlanError> plan(const TimelineSet& timelines, const PlanRequest& request) {
+    stats = PlanStats{};
     if (auto bad = check_request(timelines, request)) return unexpected(std::move(*bad));
     const auto [traversal, class_id] = traversals.get(*graph, request.vehicle);
     if (auto bad = check_usable(*traversal, request)) return unexpected(std::move(*bad));
+    // A blocked start makes the search fail at once, after the heuristic (about 1 000
+    // expansions each on the warehouse map). When the legs are known to be reachable,
+    // prepare_legs cannot fail, so the same answer comes without it: the goal check,
+    // then the blocked start, in the order of the checks below.
+    if (!start_free(timelines, request) && legs_reachable(*traversal, request)) {
+      if (auto bad = check_goal_held(timelines, request)) return unexpected(std::move(*bad));
+      return unexpected(blocked_start(timelines, request));
+    }
     if (auto bad = prepare_legs(*traversal, class_id, request)) {
       return unexpected(std::move(*bad));
     }
@@ -342,7 +371,10 @@ struct Planner::Impl {
     input.start_time = request.start_time;
     input.legs = legs;
     input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
+    input.floor_proof_after = options.floor_proof_after;
+    input.floor_proof_budget = options.floor_proof_budget;
     const SearchOutcome outcome = search.run(input);
+    stats = search.stats();
     if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));
     return search.route(input);
   }
@@ -355,6 +387,8 @@ Planner::Planner(Planner&&) noexcept = default;
 Planner& Planner::operator=(Planner&&) noexcept = default;
 
 const RoutingGraph& Planner::graph() const noexcept { return *impl_->graph; }
+
+const PlanStats& Planner::last_stats() const noexcept { return impl_->stats; }
 
 Result<Route, PlanError> Planner::plan(const TimelineSet& timelines, const PlanRequest& request) {
   return impl_->plan(timelines, request);

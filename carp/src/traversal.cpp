@@ -38,6 +38,56 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   ns_per_metre_ = std::isfinite(ns_per_metre) ? ns_per_metre * (1 - 1e-9) : 0;
 }
 
+void Traversal::find_components(const RoutingGraph& graph) const {
+  const std::size_t n = graph.vertex_count();
+  constexpr std::uint32_t kUnset = 0xffffffffu;
+  // 1. Vertices in order of finishing a depth-first search along the usable arcs.
+  std::vector<EntityIndex> finished;
+  finished.reserve(n);
+  std::vector<std::uint8_t> seen(n, 0);
+  std::vector<std::pair<EntityIndex, ArcIndex>> stack;  // vertex, next arc to try
+  for (EntityIndex root = 0; root < n; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    stack.emplace_back(root, graph.arcs_begin(root));
+    while (!stack.empty()) {
+      auto& [v, a] = stack.back();
+      if (a == graph.arcs_end(v)) {
+        finished.push_back(v);
+        stack.pop_back();
+        continue;
+      }
+      const ArcIndex arc = a++;
+      const EntityIndex to = graph.arc(arc).to;
+      if (usable_arc_[arc] && !seen[to]) {
+        seen[to] = 1;
+        stack.emplace_back(to, graph.arcs_begin(to));
+      }
+    }
+  }
+  // 2. In reverse finishing order, what reaches each new root backwards is its component.
+  component_.assign(n, kUnset);
+  std::vector<EntityIndex> pending;
+  std::uint32_t next = 0;
+  for (auto it = finished.rbegin(); it != finished.rend(); ++it) {
+    if (component_[*it] != kUnset) continue;
+    component_[*it] = next;
+    pending.push_back(*it);
+    while (!pending.empty()) {
+      const EntityIndex v = pending.back();
+      pending.pop_back();
+      for (const ArcIndex arc : graph.arcs_into(v)) {
+        const EntityIndex from = graph.arc(arc).from;
+        if (usable_arc_[arc] && component_[from] == kUnset) {
+          component_[from] = next;
+          pending.push_back(from);
+        }
+      }
+    }
+    ++next;
+  }
+}
+
 bool Traversal::same_class(const VehicleProfile& a, const VehicleProfile& b) {
   return a.max_speed == b.max_speed && a.length == b.length && a.width == b.width &&
          a.payload == b.payload && a.type == b.type;

@@ -41,12 +41,30 @@ class Traversal {
 
   const VehicleProfile& vehicle() const noexcept { return vehicle_; }
 
+  /// True when `a` and `b` lie in one strongly connected component of the usable arcs, so
+  /// that the vehicle can drive from either to the other (reservations aside). False says
+  /// nothing: b may still be reachable from a.
+  /// The components are found on the first call (only the planner asks; FreePathSearch,
+  /// the benchmark's baseline, keeps traversals of its own and never pays for them).
+  bool mutually_reachable(const RoutingGraph& graph, topology::EntityIndex a,
+                          topology::EntityIndex b) const {
+    if (a == b) return true;
+    if (component_.empty()) find_components(graph);
+    return component_[a] == component_[b];
+  }
+
  private:
+  /// Fills component_ (Kosaraju, iterative) over the usable arcs.
+  void find_components(const RoutingGraph& graph) const;
+
   VehicleProfile vehicle_;
   std::vector<DurationNs> travel_;
   std::vector<DurationNs> clearance_;
   std::vector<std::uint8_t> usable_vertex_;
   std::vector<std::uint8_t> usable_arc_;
+  // Per vertex: its strongly connected component; empty until mutually_reachable needs it
+  // (a cache: a traversal is used by one planner, on one thread).
+  mutable std::vector<std::uint32_t> component_;
   double ns_per_metre_ = 0;
 };
 

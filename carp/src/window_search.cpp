@@ -7,6 +7,20 @@ namespace drover::carp {
 using topology::EntityIndex;
 using topology::Interval;
 
+namespace {
+
+/// How many times a search raises the arrival floor in a row (each by one proof). Once a
+/// search has expanded input.floor_proof_after states keyed by the floor, it tries to prove
+/// the floor too early (prove_late) with a budget of input.floor_proof_budget backward
+/// states (by default as many); if that fails, it tries again at four times as many with
+/// four times the budget, so the proofs cost at most about half the expansions. A floor
+/// one step below the arrival can cost tens of thousands of expansions (warehouse N = 400:
+/// 12 000 for an agent that needs 60 with the exact floor), while most searches expand only
+/// a few hundred states and never try.
+constexpr int kLateProofRounds = 8;
+
+}  // namespace
+
 void WindowSearch::begin(const SearchInput& input) {
   if (++generation_ == 0) {  // wrapped: every stamp could look current
     std::fill(entity_stamp_.begin(), entity_stamp_.end(), 0);
@@ -34,6 +48,12 @@ void WindowSearch::begin(const SearchInput& input) {
   open_.clear();
   sequence_ = 0;
   goal_state_ = kNone;
+  arrival_floor_ = 0;
+  floor_pops_ = 0;
+  next_proof_at_ = input.floor_proof_after;
+  proof_budget_ = input.floor_proof_budget;
+  floor_proofs_ = 0;
+  floor_raises_ = 0;
 }
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
@@ -148,6 +168,164 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   return kForever;
 }
 
+bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
+  if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return true;
+  const TimeNs floor = arrival_floor_;
+  for (int round = 0; round < kLateProofRounds; ++round) {
+    const LateProof proof = prove_late(input, arrival_floor_, proof_budget_);
+    ++floor_proofs_;
+    if (!proof.proven) break;
+    ++floor_raises_;
+    if (proof.margin == kForever) {
+      arrival_floor_ = kForever;
+      return false;
+    }
+    arrival_floor_ += proof.margin;
+  }
+  if (arrival_floor_ == floor) {
+    proof_budget_ *= 4;
+    next_proof_at_ *= 4;
+    return true;
+  }
+  floor_pops_ = 0;
+  next_proof_at_ = input.floor_proof_after;
+  // Every open key is at least the new floor; entries of states closed since are dropped.
+  open_.rebuild([this](const OpenEntry& e) { return !states_[e.state].closed; },
+                [this](OpenEntry& e) { e.f = std::max(e.ready + e.h, arrival_floor_); });
+  return true;
+}
+
+// Why a proof is sound (reviewed 2026-11-25). Take any route of the forward model (drive)
+// arriving by deadline + d, 0 <= d < margin: states s_0 (the start state) ... s_n (the
+// stop's open-ended window), ready at r_i. Backwards from s_n, every s_i is reached with a
+// final label (latest, cap) such that latest >= r_i - d and cap >= r_i:
+// - s_n: latest = deadline >= r_n - d, cap = kForever.
+// - Step from s_(i+1) over arc a, edge window e, window W of s_i, onto the edge at y: the
+//   route has max(r_i, e.start) <= y <= min(r_(i+1), e.end - clearance) - travel,
+//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + lower_bound (the
+//   straight-line bound is consistent with travel()). So the checks that do not depend on
+//   the deadline (`continue` without fails_by) pass; the label side of the others is
+//   >= y - d (latest) and >= y (cap): the edge check's top.latest - travel, and
+//   latest_onto_edge, are >= y - d; the window and straight-line checks' label >= r_i - d.
+//   Had one failed, it would have recorded a gap <= d < margin (its cap reaches the fixed
+//   time, so it counts). The breaks skip only windows that start later (larger gaps). So
+//   s_i is reached with latest >= min(y - d, W.end - clearance) >= r_i - d and cap >= r_i.
+//   Labels keep the max of `latest` and of `cap` separately (an over-approximation), and a
+//   label that grows is expanded again, so the checks are made with the final label too.
+// - At the route's last visit to the start window (it could as well have waited there from
+//   the start time), the start check either returned "not proven" or recorded
+//   start_time - latest <= d. Contradiction: no route arrives by deadline + d.
+// (Before the search: no arrival precedes the open-ended window's start, hence that margin.)
+// The horizon and the heuristic's unreachable vertices are not checked (a relaxation: a
+// proof only gets rarer); usable_vertex(from) holds for every vertex a route leaves (an arc
+// needs a usable destination, check_usable the start). Every gap is > 0, so the floor
+// rises strictly. It stays a lower bound of every arrival, so the keys
+// max(ready + h, floor) stay admissible, improve() reopens closed states, and the first
+// completed state popped is the earliest arrival. planner_random_test checks the final
+// floor itself against the brute force.
+WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeNs deadline,
+                                                 std::size_t budget) {
+  const RoutingGraph& graph = *input.graph;
+  const Traversal& traversal = *input.traversal;
+  if (++late_generation_ == 0) {  // wrapped: every stamp could look current
+    std::fill(late_stamp_.begin(), late_stamp_.end(), 0);
+    late_generation_ = 1;
+  }
+  late_open_.clear();
+  DurationNs margin = kForever;
+  // A check failed because `latest` is earlier than the fixed time `needed`. With a later
+  // deadline, `latest` grows at most as much, and never beyond `cap` (its value for a
+  // deadline that never comes).
+  const auto fails_by = [&margin](TimeNs needed, TimeNs latest, TimeNs cap) {
+    if (cap >= needed) margin = std::min(margin, needed - latest);
+  };
+  // A state is expanded again when only its cap grew: its successors' caps may grow too.
+  const auto reach = [this](EntityIndex vertex, std::uint32_t window, TimeNs latest, TimeNs cap) {
+    if (late_stamp_.size() < windows_.size()) {
+      late_stamp_.resize(windows_.size(), 0);
+      late_labels_.resize(windows_.size());
+    }
+    LateLabel& label = late_labels_[window];
+    if (late_stamp_[window] == late_generation_) {
+      if (latest <= label.latest && cap <= label.cap) return;
+      label = LateLabel{std::max(latest, label.latest), std::max(cap, label.cap)};
+    } else {
+      late_stamp_[window] = late_generation_;
+      label = LateLabel{latest, cap};
+    }
+    late_open_.push(LateEntry{label.latest, label.cap, window, vertex});
+  };
+
+  std::uint32_t goal_count = 0;
+  const std::uint32_t goal_first = windows_of(input, input.legs.back().stop, goal_count);
+  if (goal_count == 0 || windows_[goal_first + goal_count - 1].end != kForever) {
+    return LateProof{true, kForever};  // never held open-ended
+  }
+  const std::uint32_t held = goal_first + goal_count - 1;
+  if (windows_[held].start > deadline) return LateProof{true, windows_[held].start - deadline};
+  reach(input.legs.back().stop, held, deadline, kForever);
+  std::uint32_t start_count = 0;
+  const std::uint32_t start_window = windows_of(input, input.start, start_count);
+
+  std::size_t visited = 0;
+  while (!late_open_.empty()) {
+    const LateEntry top = late_open_.pop();
+    const LateLabel& label = late_labels_[top.window];
+    if (label.latest != top.latest || label.cap != top.cap) continue;  // superseded
+    if (++visited > budget) return LateProof{};
+    if (top.vertex == input.start && top.window == start_window) {
+      // The search's first state: ready at the start time, and never reached again.
+      if (top.latest >= input.start_time) return LateProof{};
+      fails_by(input.start_time, top.latest, top.cap);
+      continue;
+    }
+    const Interval into = windows_[top.window];
+    for (const ArcIndex a : graph.arcs_into(top.vertex)) {
+      const EntityIndex from = graph.arc(a).from;
+      if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
+      const DurationNs travel = traversal.travel(a);
+      const DurationNs clearance = traversal.clearance(a);
+      std::uint32_t edge_count = 0;
+      const std::uint32_t edge_first = windows_of(input, graph.arc(a).edge, edge_count);
+      for (std::uint32_t i = 0; i < edge_count; ++i) {
+        // As in drive: onto the edge at y >= edge.start, arriving at z >= y + travel and
+        // z >= into.start, with z + clearance <= edge.end and z <= top.latest.
+        const Interval edge = windows_[edge_first + i];
+        const TimeNs latest_arrival = edge.end - clearance;
+        if (latest_arrival < into.start || latest_arrival - travel < edge.start) continue;
+        const TimeNs latest_onto_edge = std::min(top.latest, latest_arrival) - travel;
+        const TimeNs cap_onto_edge = std::min(top.cap, latest_arrival) - travel;
+        if (latest_onto_edge < edge.start) {  // later windows start later still
+          fails_by(edge.start, top.latest - travel, top.cap - travel);
+          break;
+        }
+        std::uint32_t from_count = 0;
+        const std::uint32_t from_first = windows_of(input, from, from_count);
+        for (std::uint32_t j = 0; j < from_count; ++j) {
+          // Ready at r >= window.start, onto the edge at max(r, edge.start), off the vertex
+          // (tail included) before the window ends.
+          const Interval window = windows_[from_first + j];
+          if (window.end - clearance < std::max(window.start, edge.start)) continue;
+          if (latest_onto_edge < window.start) {  // later windows start later still
+            fails_by(window.start, latest_onto_edge, cap_onto_edge);
+            break;
+          }
+          const TimeNs latest = std::min(latest_onto_edge, window.end - clearance);
+          const TimeNs cap = std::min(cap_onto_edge, window.end - clearance);
+          const TimeNs earliest =
+              input.start_time + traversal.lower_bound(graph, input.start, from);
+          if (latest < earliest) {
+            fails_by(earliest, latest, cap);
+            continue;
+          }
+          reach(from, from_first + j, latest, cap);
+        }
+      }
+    }
+  }
+  return LateProof{true, margin};
+}
+
 WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estimate,
                                                  std::uint32_t state) {
   return OpenEntry{std::max(ready + estimate, arrival_floor_), estimate, ready, sequence_++,
@@ -243,6 +421,13 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
     const OpenEntry top = open_.pop();
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
+    if (top.f == arrival_floor_ && ++floor_pops_ == next_proof_at_) {
+      if (!raise_arrival_floor(input)) return outcome;
+      if (top.f < arrival_floor_) {  // the key rose: back to the open list
+        open_.push(open_entry(top.ready, top.h, top.state));
+        continue;
+      }
+    }
     popped.closed = true;
     const State current = popped;  // states_ may grow below
     if (current.vertex == input.legs[current.layer].stop &&

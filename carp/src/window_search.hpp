@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "drover/carp/planner.hpp"
 #include "drover/carp/route.hpp"
 #include "heuristic.hpp"
 #include "min_heap.hpp"
@@ -43,6 +44,8 @@ struct SearchInput {
   std::span<const Leg> legs;
   TimeNs deadline = 0;         ///< states that could only leave later are dropped
   bool count_locks = true;
+  std::size_t floor_proof_after = 256;   ///< PlannerOptions::floor_proof_after
+  std::size_t floor_proof_budget = 256;  ///< PlannerOptions::floor_proof_budget
 };
 
 struct SearchOutcome {
@@ -56,6 +59,10 @@ class WindowSearch {
   SearchOutcome run(const SearchInput& input);
   /// The route found by the last run(). \pre it found one
   Route route(const SearchInput& input) const;
+  /// What the last run() did.
+  PlanStats stats() const {
+    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_};
+  }
 
  private:
   struct State {
@@ -106,6 +113,26 @@ class WindowSearch {
   /// The earliest arrival at the last stop along `arc` that its edge's windows allow, if
   /// before `bound`; kForever otherwise.
   TimeNs arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound);
+  /// Raises arrival_floor_ while prove_late proves that no route arrives by it, and re-keys
+  /// the open list. Only for one open-ended stop. Called once a search has expanded many
+  /// states keyed by the floor: all that could arrive by the floor share it as key, and with
+  /// a floor below the arrival every one of them must be expanded.
+  /// \return false when no route can ever arrive (a certificate of failure).
+  bool raise_arrival_floor(const SearchInput& input);
+  /// What a backward search from the last stop found about arrivals by a deadline.
+  struct LateProof {
+    bool proven = false;     ///< no route arrives by the deadline
+    DurationNs margin = 0;   ///< if proven: nor by deadline + margin - 1 ns; kForever: never
+  };
+  /// A backward search over (vertex, free window) states from the open-ended window of the
+  /// last stop, labelled with the latest time the vehicle may be ready there and still arrive
+  /// by `deadline`; states the vehicle cannot reach in time (the straight-line bound from the
+  /// start) are dropped. If it ends without reaching the start state, no route arrives by
+  /// the deadline. Each check it failed compares a time that grows at most as fast as the
+  /// deadline with a fixed one; the smallest gap is a margin by which the deadline can grow
+  /// with every check still failing, so with no route arriving. Gives up (not proven) after
+  /// `budget` states.
+  LateProof prove_late(const SearchInput& input, TimeNs deadline, std::size_t budget);
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
@@ -165,8 +192,32 @@ class WindowSearch {
   std::uint64_t agent_bit_ = 0;   // TimelineSet::agent_bit of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
+  /// The label of a state of prove_late's backward search: the latest time the vehicle may
+  /// be ready there, and the most that time can become however late the deadline.
+  struct LateLabel {
+    TimeNs latest = 0;
+    TimeNs cap = 0;
+  };
+  /// An open state of that search: `window` (an index into windows_) of `vertex`. The
+  /// latest first.
+  struct LateEntry {
+    TimeNs latest;
+    TimeNs cap;
+    std::uint32_t window;
+    topology::EntityIndex vertex;
+    bool operator>(const LateEntry& o) const { return latest < o.latest; }
+  };
+  MinHeap<LateEntry> late_open_;
+  std::vector<LateLabel> late_labels_;     // per window index, valid where stamped
+  std::vector<std::uint32_t> late_stamp_;  // per window index
+  std::uint32_t late_generation_ = 0;
   std::uint32_t sequence_ = 0;
   TimeNs arrival_floor_ = 0;  // no arrival at the last stop can be earlier (see arrival_floor)
+  std::size_t floor_pops_ = 0;     // states expanded with the floor as key, since it last rose
+  std::size_t next_proof_at_ = 0;  // floor_pops_ at which raise_arrival_floor is tried
+  std::size_t proof_budget_ = 0;   // backward states prove_late may visit
+  std::size_t floor_proofs_ = 0;   // prove_late calls in this search
+  std::size_t floor_raises_ = 0;   // of which proven
   std::uint32_t goal_state_ = kNone;
 };
 

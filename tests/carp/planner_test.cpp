@@ -234,6 +234,36 @@ TEST(Planner, ReportsWhyTheStartIsNotFree) {
             PlanFailure::locked);
 }
 
+TEST(Planner, ABlockedStartIsReportedOnlyAfterTheChecksThatComeFirst) {
+  // The planner tells a blocked start before computing the heuristic when the stops are
+  // known to be reachable; the failure must be the one of the usual order all the same.
+  GridBuilder g;
+  g.cell(0, 0).cell(1, 0).cell(2, 0).cell(5, 5);
+  g.edge(0, 0, 1, 0, {.bidirectional = false}).edge(1, 0, 2, 0);
+  World w(std::move(g).build());
+  w.occupy("b", "0,0", sec(0), sec(10));
+  const auto start_message = [](const PlanError& e) {
+    return e.message.find("start vertex '0,0' is not free") != std::string::npos;
+  };
+  // Reachable, though not back (one-way): the blocked start, found by the search.
+  const PlanError one_way = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+  EXPECT_EQ(one_way.reason, PlanFailure::no_window);
+  EXPECT_TRUE(start_message(one_way)) << one_way.message;
+  // Unreachable comes first.
+  EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "5,5")})).reason,
+            PlanFailure::unreachable);
+  // Within a strongly connected part: the goal held for good comes first, then the start.
+  World c(GridBuilder().corridor(4).build());
+  c.occupy("b", "0,0", sec(0), sec(10));
+  const PlanError blocked = plan_error(c, request_to(c, "a", "0,0", {open_stop(c, "3,0")}));
+  EXPECT_EQ(blocked.reason, PlanFailure::no_window);
+  EXPECT_TRUE(start_message(blocked)) << blocked.message;
+  ASSERT_TRUE(c.timelines.lock(c.at("3,0"), {sec(20), kForever}, "op", "closed"));
+  const PlanError goal = plan_error(c, request_to(c, "a", "0,0", {open_stop(c, "3,0")}));
+  EXPECT_EQ(goal.reason, PlanFailure::locked);
+  EXPECT_NE(goal.message.find("never free for good"), std::string::npos) << goal.message;
+}
+
 TEST(Planner, GivesUpAtTheHorizon) {
   World w(GridBuilder().corridor(5).build(), PlannerOptions{.horizon = sec(10)});
   w.occupy("b", "2,0", sec(0), sec(100));

@@ -394,6 +394,7 @@ TEST_F(TimelineTest, LockReportsWhatItHitsAndBlocksNewReservations) {
   EXPECT_EQ(lock->hit[1].agent, "bob");
   EXPECT_TRUE(lock->hit[1].shadow());
   ASSERT_EQ(set.timeline(0).locks.size(), 1u);
+  EXPECT_EQ(set.lock_count(), 1u);
   EXPECT_EQ(set.timeline(0).locks[0],
             (Lock{lock->id, 0, {5, 25}, "olga", "broken floor plate"}));
   EXPECT_EQ(set.timeline(0).reservations.size(), 2u);  // nothing is revoked
@@ -405,7 +406,9 @@ TEST_F(TimelineTest, LockReportsWhatItHitsAndBlocksNewReservations) {
   EXPECT_TRUE(set.reserve("cat", 2, {at(2, 5, 15)}));
   ASSERT_TRUE(set.unlock(lock->id));
   EXPECT_TRUE(set.timeline(0).locks.empty());
+  EXPECT_EQ(set.lock_count(), 0u);
   EXPECT_EQ(set.unlock(lock->id).error().code, ErrorCode::not_found);
+  EXPECT_EQ(set.lock_count(), 0u);
   EXPECT_TRUE(set.reserve("amy", 2, {at(0, 20, 30)}));
 }
 
@@ -421,10 +424,12 @@ TEST_F(TimelineTest, ALockTakenInThroughAReplicatedTimelineBlocksItsConflictSetU
   published.version = 3;
   published.locks.push_back(Lock{9, 1, {0, 100}, "olga", "spill"});
   ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.lock_count(), 1u);
   EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{100, 200}}));
   published.version = 4;
   published.locks.clear();
   ASSERT_TRUE(set.replace_timeline(1, published));
+  EXPECT_EQ(set.lock_count(), 0u);
   EXPECT_EQ(set.free_windows(0, "amy", 0, 200), windows({{0, 200}}));
 }
 

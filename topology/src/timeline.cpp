@@ -106,6 +106,8 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
 
 std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }
 
+std::size_t TimelineSet::lock_count() const noexcept { return lock_count_; }
+
 bool TimelineSet::owns(EntityIndex entity) const noexcept {
   return entity < owned_.size() && owned_[entity];
 }

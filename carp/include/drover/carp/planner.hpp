@@ -16,6 +16,23 @@ struct PlannerOptions {
   DurationNs horizon = 3600 * kNsPerSecond;
   /// How many heuristic tables (one per goal and vehicle class) are kept between calls.
   std::size_t heuristic_tables = 64;
+  /// After expanding this many states keyed by the arrival floor (the earliest the last
+  /// stop can be entered and held), a search tries to prove that no route arrives that
+  /// early and raises the floor (docs/carp.md); four times as many before each further try.
+  /// Any value >= 1 gives the same arrivals; 256 pays off on the benchmark's maps.
+  std::size_t floor_proof_after = 256;
+  /// How many backward states such a proof may visit before it gives up; four times as many
+  /// at each further try. Any value >= 1 gives the same arrivals.
+  std::size_t floor_proof_budget = 256;
+};
+
+/// What the search of the last Planner::plan call did (for tests and measurements).
+struct PlanStats {
+  /// The arrival floor the search ended with: no route arrives earlier (kForever when a
+  /// proof showed that none ever arrives). 0 when no search ran.
+  TimeNs arrival_floor = 0;
+  std::size_t floor_proofs = 0;  ///< backward proofs tried
+  std::size_t floor_raises = 0;  ///< proofs that raised the floor
 };
 
 /// The route planner of a routing agent. It keeps search memory and heuristic tables
@@ -49,6 +66,10 @@ class Planner {
                                             topology::RouteId route);
 
   const RoutingGraph& graph() const noexcept;
+
+  /// What the search of the last plan (or plan_and_reserve) call did; only the first search
+  /// counts, not the searches that explain a failure.
+  const PlanStats& last_stats() const noexcept;
 
  private:
   struct Impl;

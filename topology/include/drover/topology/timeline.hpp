@@ -204,6 +204,9 @@ class TimelineSet {
 
   std::size_t entity_count() const noexcept;
   bool owns(EntityIndex entity) const noexcept;
+  /// How many locks the set holds, over all its timelines (all owned: lock, restore and
+  /// replace_timeline take locks on owned entities only). Constant time.
+  std::size_t lock_count() const noexcept;
   /// \pre owns(entity)
   const Timeline& timeline(EntityIndex entity) const;
   /// The entity's version (0 for an entity out of range).
