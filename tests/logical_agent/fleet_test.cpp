@@ -412,6 +412,25 @@ class FleetTest : public ::testing::Test {
     ASSERT_TRUE(wait_ready("V2", "right-0"));
   }
 
+  /// After an agent's crash: the crossing orders v1-there and v2-there finish, then a new
+  /// order v1-back to left-0 (which needs the restarted agent), with no two footprints
+  /// overlapping and no alarm. Call through ASSERT_NO_FATAL_FAILURE.
+  void expect_crossing_orders_and_one_more_finish() {
+    const auto first = wait_order("v1-there");
+    const auto second = wait_order("v2-there");
+    ASSERT_TRUE(first && second) << "an order did not end";
+    EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
+    EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
+    ASSERT_EQ(send_order("V1", "v1-back", {{"left-0", "NOP"}}), "");
+    const auto back = wait_order("v1-back");
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
+
+    std::lock_guard lock(seen_.mutex);
+    EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+    for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+  }
+
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
   bool wait_ready(const std::string& vehicle, const std::string& vertex) {
     return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
@@ -584,20 +603,8 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheRoutingAgent) {
   ASSERT_TRUE(wait_status("V2", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V2 never started";
   fleet.crash_and_restart("routing");
 
-  const auto first = wait_order("v1-there");
-  const auto second = wait_order("v2-there");
-  ASSERT_TRUE(first && second) << "an order did not end";
-  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
-  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
   // A new order needs a new route from the restarted routing agent.
-  ASSERT_EQ(send_order("V1", "v1-back", {{"left-0", "NOP"}}), "");
-  const auto back = wait_order("v1-back");
-  ASSERT_TRUE(back.has_value());
-  EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
-
-  std::lock_guard lock(seen_.mutex);
-  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
-  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+  ASSERT_NO_FATAL_FAILURE(expect_crossing_orders_and_one_more_finish());
 }
 
 TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
@@ -611,20 +618,8 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
   ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
   fleet.crash_and_restart("topology");
 
-  const auto first = wait_order("v1-there");
-  const auto second = wait_order("v2-there");
-  ASSERT_TRUE(first && second) << "an order did not end";
-  EXPECT_EQ(first->state(), msg::ORDER_FINISHED) << first->failure();
-  EXPECT_EQ(second->state(), msg::ORDER_FINISHED) << second->failure();
   // A new route is reserved and allocated at the restarted topology agent.
-  ASSERT_EQ(send_order("V1", "v1-back", {{"left-0", "NOP"}}), "");
-  const auto back = wait_order("v1-back");
-  ASSERT_TRUE(back.has_value());
-  EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
-
-  std::lock_guard lock(seen_.mutex);
-  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
-  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+  ASSERT_NO_FATAL_FAILURE(expect_crossing_orders_and_one_more_finish());
 }
 
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
