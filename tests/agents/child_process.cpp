@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,32 +15,30 @@
 #include <sstream>
 #include <utility>
 
-extern char** environ;
+#include "drover/launcher/process.hpp"
 
 namespace drover::test {
 
 std::optional<ChildProcess> ChildProcess::spawn(const std::string& path, const std::vector<std::string>& args,
                                                 const std::string& stdout_file,
                                                 const std::string& stderr_file) {
-  std::vector<std::string> argv_storage;
-  argv_storage.push_back(path);
-  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& arg : argv_storage) argv.push_back(arg.data());
-  argv.push_back(nullptr);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  constexpr int kFlags = O_WRONLY | O_CREAT | O_TRUNC;
-  if (!stdout_file.empty()) posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, stdout_file.c_str(), kFlags, 0644);
-  if (!stderr_file.empty()) posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_file.c_str(), kFlags, 0644);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, path.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) {
-    std::cerr << "cannot start " << path << ": " << std::strerror(error) << "\n";
-    return std::nullopt;
+  const auto open_output = [](const std::string& file) {
+    return file.empty() ? -1 : ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  };
+  const int out = open_output(stdout_file);
+  const int err = open_output(stderr_file);
+  std::optional<pid_t> started;
+  if ((out < 0 && !stdout_file.empty()) || (err < 0 && !stderr_file.empty())) {
+    std::cerr << "cannot open the output files of " << path << ": " << std::strerror(errno) << "\n";
+  } else if (auto spawned = launcher::spawn_child(path, args, out, err); !spawned) {
+    std::cerr << spawned.error().message << "\n";
+  } else {
+    started = *spawned;
   }
+  if (out >= 0) ::close(out);
+  if (err >= 0) ::close(err);
+  if (!started) return std::nullopt;
+  const pid_t pid = *started;
   const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
   if (pidfd < 0) {
     std::cerr << "pidfd_open failed: " << std::strerror(errno) << "\n";

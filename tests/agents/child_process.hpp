@@ -1,7 +1,8 @@
 #pragma once
-// A child process for multi-process tests: spawned with posix_spawn, waited for through a
-// pidfd (no sleeps), and always killed and reaped when the object goes away, even when an
-// assertion failed half-way.
+// A child process for multi-process tests: started by launcher::spawn_child (so it gets
+// SIGTERM if the test dies, say killed by a CTest timeout, instead of running on in its
+// domain), waited for through a pidfd (no sleeps), and always killed and reaped when the
+// object goes away, even when an assertion failed half-way.
 
 #include <sys/types.h>
 

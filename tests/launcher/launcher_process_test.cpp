@@ -1,10 +1,11 @@
-// `drover launch` as a process (domains 94..97): it starts the agents of a launch file,
+// `drover launch` as a process (domains 79, 94..97): it starts the agents of a launch file,
 // prefixes their lines with their agent ids, restarts a crashed agent whose entry says so,
 // stops on SIGTERM and after --duration with exit 0, exits 1 when an agent failed for good
-// and 2 for a bad launch file, before starting anything.
+// and 2 for a bad launch file, before starting anything; its agents never outlive it.
 
 #include <signal.h>
 
+#include <algorithm>
 #include <regex>
 
 #include "tests/launcher/launch_test_support.hpp"
@@ -75,6 +76,47 @@ TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
     EXPECT_NE(::kill(pid, 0), 0) << "agent pid " << pid << " outlived the launcher";
   }
   EXPECT_NE(read_file(err.string()).find("[ran-V1] "), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+/// True while `pid` is a process that has not ended (a zombie has ended: when the
+/// launcher is gone, whoever adopts its agents may reap them late).
+bool running(pid_t pid) {
+  const std::string stat = read_file("/proc/" + std::to_string(pid) + "/stat");
+  const auto state = stat.rfind(") ");  // the state follows the command name
+  return state != std::string::npos && stat.at(state + 2) != 'Z';
+}
+
+TEST(LauncherProcess, AgentsEndWhenTheLauncherIsKilled) {
+  const auto dir = scratch_dir("launch_killed");
+  write_text(dir / "fleet.json", loop_launch(79, R"(
+      {"kind": "topology"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
+  auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
+                                      (dir / "out.txt").string(), (dir / "err.txt").string());
+  ASSERT_TRUE(launcher.has_value());
+  const auto err = dir / "err.txt";
+  ASSERT_TRUE(wait_for_output(err, [](const std::string& text) {
+    return text.find("simulated vehicle 'V1'") != std::string::npos &&
+           text.find("[topology] ") != std::string::npos;
+  })) << read_file(err.string());
+  const auto agents = started_pids(read_file(err.string()), "[a-zA-Z0-9-]+");
+  ASSERT_EQ(agents.size(), 2u);
+
+  // No chance to stop them in order: each agent gets SIGTERM from the kernel instead.
+  launcher->signal(SIGKILL);
+  ASSERT_TRUE(launcher->wait_exit(60s).has_value());
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  const auto any_running = [&agents] {
+    return std::any_of(agents.begin(), agents.end(), running);
+  };
+  while (any_running() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(50ms);
+  }
+  for (const pid_t pid : agents) {
+    EXPECT_FALSE(running(pid)) << "agent pid " << pid << " outlived the killed launcher";
+    if (running(pid)) ::kill(pid, SIGKILL);
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -28,9 +28,9 @@ void close_pair(int fds[2]) {
   sigprocmask(SIG_SETMASK, &none, nullptr);
   setpgid(0, 0);
   prctl(PR_SET_PDEATHSIG, SIGTERM);
-  if (getppid() != parent) _exit(1);  // the launcher died before prctl took effect
-  dup2(out_fd, STDOUT_FILENO);
-  dup2(err_fd, STDERR_FILENO);
+  if (getppid() != parent) _exit(1);  // the parent died before prctl took effect
+  if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
+  if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
   close_range(3, UINT_MAX, 0);
   execv(executable, argv);
   const char* reason = strerror(errno);
@@ -45,8 +45,8 @@ void close_pair(int fds[2]) {
 
 }  // namespace
 
-Result<SpawnedProcess> spawn_process(const std::string& executable,
-                                     const std::vector<std::string>& arguments) {
+Result<pid_t> spawn_child(const std::string& executable, const std::vector<std::string>& arguments,
+                          int stdout_fd, int stderr_fd) {
   // argv is built before fork: the child may not allocate.
   std::vector<std::string> storage;
   storage.reserve(arguments.size() + 1);
@@ -56,6 +56,18 @@ Result<SpawnedProcess> spawn_process(const std::string& executable,
   for (auto& argument : storage) argv.push_back(argument.data());
   argv.push_back(nullptr);
 
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    return fail(ErrorCode::io,
+                "cannot fork to start " + executable + ": " + std::strerror(errno));
+  }
+  if (pid == 0) exec_child(parent, storage.front().c_str(), argv.data(), stdout_fd, stderr_fd);
+  return pid;
+}
+
+Result<SpawnedProcess> spawn_process(const std::string& executable,
+                                     const std::vector<std::string>& arguments) {
   int out[2] = {-1, -1};
   int err[2] = {-1, -1};
   if (::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(err, O_CLOEXEC) != 0) {
@@ -64,20 +76,17 @@ Result<SpawnedProcess> spawn_process(const std::string& executable,
     close_pair(err);
     return fail(ErrorCode::io, "cannot create pipes for " + executable + ": " + reason);
   }
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    const std::string reason = std::strerror(errno);
-    close_pair(out);
-    close_pair(err);
-    return fail(ErrorCode::io, "cannot fork to start " + executable + ": " + reason);
-  }
-  if (pid == 0) exec_child(parent, storage.front().c_str(), argv.data(), out[1], err[1]);
+  auto pid = spawn_child(executable, arguments, out[1], err[1]);
   ::close(out[1]);
   ::close(err[1]);
+  if (!pid) {
+    ::close(out[0]);
+    ::close(err[0]);
+    return unexpected(std::move(pid).error());
+  }
   ::fcntl(out[0], F_SETFL, O_NONBLOCK);
   ::fcntl(err[0], F_SETFL, O_NONBLOCK);
-  return SpawnedProcess{pid, out[0], err[0]};
+  return SpawnedProcess{*pid, out[0], err[0]};
 }
 
 Result<std::string> current_executable() {

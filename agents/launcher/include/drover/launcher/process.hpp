@@ -1,5 +1,6 @@
 #pragma once
-// Starting an agent as a child process whose stdout and stderr come back through pipes.
+// Starting an agent as a child process that never outlives its parent; its stdout and
+// stderr come back through pipes or go to given descriptors.
 
 #include <sys/types.h>
 
@@ -18,12 +19,18 @@ struct SpawnedProcess {
   int stderr_fd = -1;
 };
 
-/// Starts `executable` with `arguments` (argv[1..]) by fork and exec. The child gets an
-/// empty signal mask, its own process group (a Ctrl-C on the terminal reaches only the
-/// launcher, which stops its agents in order) and SIGTERM when the launcher dies, so no
-/// agent outlives it; it inherits no other descriptor than the pipes and stdin.
-/// \return the child, or io when pipes or fork fail. A failed exec shows as the child
+/// Starts `executable` with `arguments` (argv[1..]) by fork and exec, its stdout and stderr
+/// on `stdout_fd` and `stderr_fd` (-1: the caller's own). The child gets an empty signal
+/// mask, its own process group (a Ctrl-C on the terminal reaches only the parent, which
+/// stops its agents in order) and SIGTERM when the thread that started it ends (its parent
+/// dies, or is killed), so no agent outlives it; it inherits no other descriptor than those
+/// two and stdin. \return its pid, or io when fork fails. A failed exec shows as the child
 /// writing the reason to its stderr and exiting with 127.
+Result<pid_t> spawn_child(const std::string& executable, const std::vector<std::string>& arguments,
+                          int stdout_fd, int stderr_fd);
+
+/// spawn_child with the child's stdout and stderr going to new pipes.
+/// \return the child and the pipes' read ends, or io when pipes or fork fail.
 Result<SpawnedProcess> spawn_process(const std::string& executable,
                                      const std::vector<std::string>& arguments);
 
