@@ -8,40 +8,36 @@ using topology::EntityIndex;
 
 void HeuristicTable::reset(const RoutingGraph& graph, EntityIndex goal) {
   goal_ = goal;
-  target_ = goal;
   distance_.assign(graph.vertex_count(), kUnreachable);
   closed_.assign(graph.vertex_count(), 0);
   open_.clear();
   distance_[goal] = 0;
-  open_.push(Entry{0, 0, goal});
-}
-
-void HeuristicTable::aim(const RoutingGraph& graph, const Traversal& traversal,
-                         EntityIndex target) {
-  if (target == target_) return;
-  target_ = target;
-  open_.rebuild(
-      [this](const Entry& e) { return !closed_[e.vertex] && e.distance == distance_[e.vertex]; },
-      [&](Entry& e) { e.key = e.distance + traversal.lower_bound(graph, e.vertex, target); });
+  open_.push(0, goal);
 }
 
 DurationNs HeuristicTable::resume(const RoutingGraph& graph, const Traversal& traversal,
                                   EntityIndex vertex) {
+  // Keys are distances in units of the shortest arc's travel time, rounded down (Dinitz):
+  // whatever the order among equal keys, a vertex's distance is final when it is popped,
+  // since every arc into it comes from a vertex with a smaller key, popped before. On
+  // uniform grids the keys are small integers, and the radix heap hardly moves an item.
+  const DurationNs unit = traversal.min_travel();
   while (!open_.empty()) {
-    const Entry top = open_.pop();
-    if (closed_[top.vertex] || top.distance != distance_[top.vertex]) continue;  // stale
-    closed_[top.vertex] = 1;
-    // Backwards: the arcs into top.vertex lead from the vertices that can reach it.
-    for (const ArcIndex a : graph.arcs_into(top.vertex)) {
+    const EntityIndex top = open_.pop().value;
+    if (closed_[top]) continue;  // stale: popped before
+    closed_[top] = 1;
+    const DurationNs distance = distance_[top];
+    // Backwards: the arcs into top lead from the vertices that can reach it.
+    for (const ArcIndex a : graph.arcs_into(top)) {
       const EntityIndex from = graph.arc(a).from;
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from) || closed_[from]) continue;
-      const DurationNs through = top.distance + traversal.travel(a);
+      const DurationNs through = distance + traversal.travel(a);
       if (through < distance_[from]) {
         distance_[from] = through;
-        open_.push(Entry{through + traversal.lower_bound(graph, from, target_), through, from});
+        open_.push(static_cast<std::uint64_t>(through / unit), from);
       }
     }
-    if (top.vertex == vertex) return top.distance;
+    if (top == vertex) return distance;
   }
   return kUnreachable;  // everything that reaches the goal is closed, and `vertex` is not
 }

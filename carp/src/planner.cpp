@@ -214,7 +214,6 @@ struct Planner::Impl {
       leg.stop = to;
       leg.dwell = request.stops[k].dwell.value_or(k + 1 == count ? kForever : 0);
       leg.table = &heuristics.table(*graph, class_id, to);
-      leg.table->aim(*graph, traversal, from);
       leg_time[k] = leg.table->distance(*graph, traversal, from);
       if (leg_time[k] == kUnreachable) {
         if (connected(*graph, from, to)) {

@@ -28,6 +28,8 @@ class Traversal {
   /// How long the vehicle spans an end vertex and the arc while passing between them:
   /// vehicle length / the same speed, rounded up.
   DurationNs clearance(ArcIndex arc) const { return clearance_[arc]; }
+  /// The shortest travel() of a usable arc (1 ns when none is usable).
+  DurationNs min_travel() const { return min_travel_; }
   bool usable_vertex(topology::EntityIndex vertex) const { return usable_vertex_[vertex] != 0; }
   /// The vehicle may drive the arc: its edge and its destination vertex allow it.
   bool usable_arc(ArcIndex arc) const { return usable_arc_[arc] != 0; }
@@ -66,6 +68,7 @@ class Traversal {
   // (a cache: a traversal is used by one planner, on one thread).
   mutable std::vector<std::uint32_t> component_;
   double ns_per_metre_ = 0;
+  DurationNs min_travel_ = 1;
 };
 
 /// The traversals of the vehicle classes seen lately (least recently used dropped first).

@@ -285,9 +285,12 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
       const DurationNs travel = traversal.travel(a);
       const DurationNs clearance = traversal.clearance(a);
+      const TimeNs earliest = input.start_time + traversal.lower_bound(graph, input.start, from);
       std::uint32_t edge_count = 0;
       const std::uint32_t edge_first = windows_of(input, graph.arc(a).edge, edge_count);
-      for (std::uint32_t i = 0; i < edge_count; ++i) {
+      // Windows ending before into.start + clearance fail the first check below: skipped.
+      for (std::uint32_t i = ending_after(edge_first, edge_count, into.start + clearance - 1);
+           i < edge_count; ++i) {
         // As in drive: onto the edge at y >= edge.start, arriving at z >= y + travel and
         // z >= into.start, with z + clearance <= edge.end and z <= top.latest.
         const Interval edge = windows_[edge_first + i];
@@ -301,7 +304,9 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
         }
         std::uint32_t from_count = 0;
         const std::uint32_t from_first = windows_of(input, from, from_count);
-        for (std::uint32_t j = 0; j < from_count; ++j) {
+        // Windows ending before edge.start + clearance fail the first check below: skipped.
+        for (std::uint32_t j = ending_after(from_first, from_count, edge.start + clearance - 1);
+             j < from_count; ++j) {
           // Ready at r >= window.start, onto the edge at max(r, edge.start), off the vertex
           // (tail included) before the window ends.
           const Interval window = windows_[from_first + j];
@@ -312,8 +317,6 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
           }
           const TimeNs latest = std::min(latest_onto_edge, window.end - clearance);
           const TimeNs cap = std::min(cap_onto_edge, window.end - clearance);
-          const TimeNs earliest =
-              input.start_time + traversal.lower_bound(graph, input.start, from);
           if (latest < earliest) {
             fails_by(earliest, latest, cap);
             continue;
@@ -362,15 +365,9 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
   // The destination's windows are read only once the edge is known to lead somewhere:
   // reading a timeline is the dearest part of a move.
   std::uint32_t vertex_first = kNone;
-  const auto later_than = [this](std::uint32_t first, std::uint32_t count, TimeNs t) {
-    const auto begin = windows_.begin() + first;
-    return static_cast<std::uint32_t>(
-        std::partition_point(begin, begin + count, [t](const Interval& w) { return w.end <= t; }) -
-        begin);
-  };
   std::uint32_t block = kNone;
   DurationNs to_go = -1;  // the heuristic of a.to, looked up only if a state improves
-  for (std::uint32_t i = later_than(edge_first, edge_count, current.ready); i < edge_count; ++i) {
+  for (std::uint32_t i = ending_after(edge_first, edge_count, current.ready); i < edge_count; ++i) {
     const Interval edge = windows_[edge_first + i];
     if (edge.start > latest_onto_edge) break;
     const TimeNs onto_edge = std::max(current.ready, edge.start);
@@ -378,7 +375,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
     if (vertex_first == kNone) vertex_first = windows_of(input, a.to, vertex_count);
-    for (std::uint32_t j = later_than(vertex_first, vertex_count, earliest_arrival);
+    for (std::uint32_t j = ending_after(vertex_first, vertex_count, earliest_arrival);
          j < vertex_count; ++j) {
       const Interval window = windows_[vertex_first + j];
       if (window.start > latest_arrival) break;

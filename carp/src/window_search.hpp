@@ -14,6 +14,7 @@
 // vertex, so edges need no states of their own. Memory is reused between searches: stamps
 // instead of clears, one arena for all windows and states.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -142,6 +143,15 @@ class WindowSearch {
     if (entity_stamp_[entity] != generation_) read_windows(input, entity);
     count = entity_count_[entity];
     return entity_first_[entity];
+  }
+  /// The offset from `first` of the first of the `count` windows at windows_[first] (sorted,
+  /// disjoint, so their ends increase) that ends after `t`; `count` if none does.
+  std::uint32_t ending_after(std::uint32_t first, std::uint32_t count, TimeNs t) const {
+    const auto begin = windows_.begin() + first;
+    return static_cast<std::uint32_t>(
+        std::partition_point(begin, begin + count,
+                             [t](const topology::Interval& w) { return w.end <= t; }) -
+        begin);
   }
   /// Appends the free windows of `entity` to windows_ and records where they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);

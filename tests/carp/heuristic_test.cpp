@@ -1,0 +1,78 @@
+// The planner's heuristic table against an independent search: on random grids whose arcs
+// take uneven times (real lengths, several speed limits, one-way edges), the distance to the
+// goal it gives every vertex is FreePathSearch's fastest travel time, whatever order the
+// vertices are asked in (the table resumes its search on demand).
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "carp/src/heuristic.hpp"
+#include "drover/carp/free_path.hpp"
+#include "grid_builder.hpp"
+#include "route_checks.hpp"
+
+namespace drover::carp::test {
+namespace {
+
+topology::Topology uneven_grid(std::mt19937& rng) {
+  std::uniform_real_distribution<double> coin(0, 1), length(0.3, 4.0);
+  const int width = std::uniform_int_distribution<int>(2, 8)(rng);
+  const int height = std::uniform_int_distribution<int>(2, 8)(rng);
+  GridBuilder g;
+  for (int x = 0; x < width; ++x) {
+    for (int y = 0; y < height; ++y) g.cell(x, y);
+  }
+  const auto maybe_edge = [&](int x1, int y1, int x2, int y2) {
+    if (x2 >= width || y2 >= height || coin(rng) < 0.15) return;
+    EdgeOptions options;
+    options.length = length(rng);
+    options.max_speed = std::array{0.5, 1.0, 1.7}[std::uniform_int_distribution<int>(0, 2)(rng)];
+    options.bidirectional = coin(rng) < 0.8;
+    if (!options.bidirectional && coin(rng) < 0.5) {
+      std::swap(x1, x2);
+      std::swap(y1, y2);
+    }
+    g.edge(x1, y1, x2, y2, options);
+  };
+  for (int x = 0; x < width; ++x) {
+    for (int y = 0; y < height; ++y) {
+      maybe_edge(x, y, x + 1, y);
+      maybe_edge(x, y, x, y + 1);
+    }
+  }
+  return std::move(g).build();
+}
+
+TEST(HeuristicTable, GivesTheFastestTravelTimeToTheGoalFromEveryVertex) {
+  std::mt19937 rng(11);
+  const VehicleProfile vehicle = unit_vehicle();
+  int compared = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const auto topology = uneven_grid(rng);
+    const auto graph = std::make_shared<RoutingGraph>(topology);
+    const Traversal traversal(*graph, vehicle);
+    FreePathSearch reference(graph);
+    const std::size_t n = graph->vertex_count();
+    std::vector<topology::EntityIndex> order(n);
+    for (std::size_t v = 0; v < n; ++v) order[v] = static_cast<topology::EntityIndex>(v);
+    HeuristicTable table;
+    for (int goal_trial = 0; goal_trial < 3; ++goal_trial) {
+      const auto goal = static_cast<topology::EntityIndex>(rng() % n);
+      table.reset(*graph, goal);  // the same table reused, as the cache does
+      std::shuffle(order.begin(), order.end(), rng);
+      for (const auto v : order) {
+        const auto path = reference.find(vehicle, v, goal);
+        const DurationNs expected = path ? path->travel_time : kUnreachable;
+        ASSERT_EQ(table.distance(*graph, traversal, v), expected)
+            << "trial " << trial << ": from " << topology.id(v) << " to " << topology.id(goal);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 1000);
+}
+
+}  // namespace
+}  // namespace drover::carp::test
