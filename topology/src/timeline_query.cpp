@@ -12,7 +12,6 @@
 // enough"). A held (allocated) reservation blocks from `from` on: nobody comes before it.
 
 #include <algorithm>
-#include <cstring>
 
 #include "drover/topology/timeline.hpp"
 #include "timeline_impl.hpp"
@@ -91,16 +90,6 @@ std::uint64_t TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs fr
     return false;
   });
   return agents;
-}
-
-std::uint64_t TimelineSet::agent_bit(std::string_view agent) noexcept {
-  // Hashes the last 8 bytes and the length only: it runs for every reservation read, and
-  // fleet ids differ at their ends ("agv-017"). Two agents sharing a bit only cost a
-  // planner an exact query.
-  std::uint64_t tail = 0;
-  const std::size_t n = std::min<std::size_t>(agent.size(), sizeof tail);
-  if (n > 0) std::memcpy(&tail, agent.data() + agent.size() - n, n);
-  return std::uint64_t{1} << (((tail ^ agent.size()) * 0x9e3779b97f4a7c15ull) >> 58);
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

@@ -25,6 +25,7 @@
 // routing agent keeps a replica for planning.
 
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <optional>
 #include <string>
@@ -244,7 +245,15 @@ class TimelineSet {
   std::uint64_t append_newcomer_windows(EntityIndex entity, TimeNs from,
                                         std::vector<Interval>& out) const;
   /// One of 64 bits, chosen by a hash of the agent id (see append_newcomer_windows).
-  static std::uint64_t agent_bit(std::string_view agent) noexcept;
+  /// Inline: it runs for every reservation a planner reads.
+  static std::uint64_t agent_bit(std::string_view agent) noexcept {
+    // Hashes the last 8 bytes and the length only: fleet ids differ at their ends
+    // ("agv-017"). Two agents sharing a bit only cost a planner an exact query.
+    std::uint64_t tail = 0;
+    const std::size_t n = agent.size() < sizeof tail ? agent.size() : sizeof tail;
+    if (n > 0) std::memcpy(&tail, agent.data() + agent.size() - n, n);
+    return std::uint64_t{1} << (((tail ^ agent.size()) * 0x9e3779b97f4a7c15ull) >> 58);
+  }
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
   /// allocation of a reservation's origin). Equal revisions of an entity, on this set or
