@@ -6,46 +6,59 @@ namespace drover::carp {
 
 using topology::EntityIndex;
 
-void HeuristicTable::reset(const RoutingGraph& graph, EntityIndex goal) {
-  goal_ = goal;
+template <Direction kDirection>
+void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex root) {
+  root_ = root;
   distance_.assign(graph.vertex_count(), kUnreachable);
   closed_.assign(graph.vertex_count(), 0);
   open_.clear();
-  distance_[goal] = 0;
-  open_.push(0, goal);
+  distance_[root] = 0;
+  open_.push(0, root);
 }
 
-DurationNs HeuristicTable::resume(const RoutingGraph& graph, const Traversal& traversal,
-                                  EntityIndex vertex) {
+template <Direction kDirection>
+DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
+                                             const Traversal& traversal, EntityIndex vertex) {
   // Keys are distances in units of the shortest arc's travel time, rounded down (Dinitz):
   // whatever the order among equal keys, a vertex's distance is final when it is popped,
   // since every arc into it comes from a vertex with a smaller key, popped before. On
   // uniform grids the keys are small integers, and the radix heap hardly moves an item.
   const DurationNs unit = traversal.min_travel();
+  const auto relax = [&](EntityIndex next, DurationNs through) {
+    if (closed_[next] || through >= distance_[next]) return;
+    distance_[next] = through;
+    open_.push(static_cast<std::uint64_t>(through / unit), next);
+  };
   while (!open_.empty()) {
     const EntityIndex top = open_.pop().value;
     if (closed_[top]) continue;  // stale: popped before
     closed_[top] = 1;
     const DurationNs distance = distance_[top];
-    // Backwards: the arcs into top lead from the vertices that can reach it.
-    for (const ArcIndex a : graph.arcs_into(top)) {
-      const EntityIndex from = graph.arc(a).from;
-      if (!traversal.usable_arc(a) || !traversal.usable_vertex(from) || closed_[from]) continue;
-      const DurationNs through = distance + traversal.travel(a);
-      if (through < distance_[from]) {
-        distance_[from] = through;
-        open_.push(static_cast<std::uint64_t>(through / unit), from);
+    if constexpr (kDirection == Direction::to_root) {
+      // Backwards: the arcs into top lead from the vertices that can reach it.
+      for (const ArcIndex a : graph.arcs_into(top)) {
+        const EntityIndex from = graph.arc(a).from;
+        if (traversal.usable_arc(a) && traversal.usable_vertex(from)) {
+          relax(from, distance + traversal.travel(a));
+        }
+      }
+    } else if (traversal.usable_vertex(top)) {  // a root the vehicle may not use leads nowhere
+      for (ArcIndex a = graph.arcs_begin(top); a != graph.arcs_end(top); ++a) {
+        if (traversal.usable_arc(a)) relax(graph.arc(a).to, distance + traversal.travel(a));
       }
     }
     if (top == vertex) return distance;
   }
-  return kUnreachable;  // everything that reaches the goal is closed, and `vertex` is not
+  return kUnreachable;  // every vertex connected with the root is closed, and `vertex` is not
 }
+
+template class DistanceTable<Direction::to_root>;
+template class DistanceTable<Direction::from_root>;
 
 HeuristicTable& HeuristicCache::table(const RoutingGraph& graph, std::uint64_t class_id,
                                       EntityIndex goal) {
   for (Entry& entry : entries_) {
-    if (entry.class_id == class_id && entry.table->goal() == goal) {
+    if (entry.class_id == class_id && entry.table->root() == goal) {
       entry.last_request = request_;
       return *entry.table;
     }

@@ -25,6 +25,7 @@ void WindowSearch::begin(const SearchInput& input) {
   if (++generation_ == 0) {  // wrapped: every stamp could look current
     std::fill(entity_stamp_.begin(), entity_stamp_.end(), 0);
     std::fill(block_stamp_.begin(), block_stamp_.end(), 0);
+    from_start_generation_ = 0;
     generation_ = 1;
   }
   const RoutingGraph& graph = *input.graph;
@@ -202,11 +203,12 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
 // - s_n: latest = deadline >= r_n - d, cap = kForever.
 // - Step from s_(i+1) over arc a, edge window e, window W of s_i, onto the edge at y: the
 //   route has max(r_i, e.start) <= y <= min(r_(i+1), e.end - clearance) - travel,
-//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + lower_bound (the
-//   straight-line bound is consistent with travel()). So the checks that do not depend on
-//   the deadline (`continue` without fails_by) pass; the label side of the others is
-//   >= y - d (latest) and >= y (cap): the edge check's top.latest - travel, and
-//   latest_onto_edge, are >= y - d; the window and straight-line checks' label >= r_i - d.
+//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + the reservation-free
+//   travel time from the start to its vertex (distance_from_start, finite: the route got
+//   there). So the checks that do not depend on the deadline (`continue` without fails_by)
+//   pass; the label side of the others is >= y - d (latest) and >= y (cap): the edge
+//   check's top.latest - travel, and latest_onto_edge, are >= y - d; the window and
+//   travel-time checks' label >= r_i - d.
 //   Had one failed, it would have recorded a gap <= d < margin (its cap reaches the fixed
 //   time, so it counts). The breaks skip only windows that start later (larger gaps). So
 //   s_i is reached with latest >= min(y - d, W.end - clearance) >= r_i - d and cap >= r_i.
@@ -285,7 +287,9 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
       const DurationNs travel = traversal.travel(a);
       const DurationNs clearance = traversal.clearance(a);
-      const TimeNs earliest = input.start_time + traversal.lower_bound(graph, input.start, from);
+      const DurationNs from_start = distance_from_start(input, from);
+      if (from_start == kUnreachable) continue;  // no route passes there, whatever the deadline
+      const TimeNs earliest = input.start_time + from_start;
       std::uint32_t edge_count = 0;
       const std::uint32_t edge_first = windows_of(input, graph.arc(a).edge, edge_count);
       // Windows ending before into.start + clearance fail the first check below: skipped.

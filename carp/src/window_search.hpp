@@ -127,13 +127,23 @@ class WindowSearch {
   };
   /// A backward search over (vertex, free window) states from the open-ended window of the
   /// last stop, labelled with the latest time the vehicle may be ready there and still arrive
-  /// by `deadline`; states the vehicle cannot reach in time (the straight-line bound from the
-  /// start) are dropped. If it ends without reaching the start state, no route arrives by
+  /// by `deadline`; states the vehicle cannot reach in time (distance_from_start) are
+  /// dropped. If it ends without reaching the start state, no route arrives by
   /// the deadline. Each check it failed compares a time that grows at most as fast as the
   /// deadline with a fixed one; the smallest gap is a margin by which the deadline can grow
   /// with every check still failing, so with no route arriving. Gives up (not proven) after
   /// `budget` states.
   LateProof prove_late(const SearchInput& input, TimeNs deadline, std::size_t budget);
+  /// The reservation-free travel time from the start to `vertex`, kUnreachable if none: the
+  /// earliest a route can be there after the start time. Found on demand, in a table set up
+  /// by the first call of each search (only searches that try a proof pay for it).
+  DurationNs distance_from_start(const SearchInput& input, topology::EntityIndex vertex) {
+    if (from_start_generation_ != generation_) {
+      from_start_.reset(*input.graph, input.start);
+      from_start_generation_ = generation_;
+    }
+    return from_start_.distance(*input.graph, *input.traversal, vertex);
+  }
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity` from the start time on: indices [first, first + count).
@@ -221,6 +231,8 @@ class WindowSearch {
   std::vector<LateLabel> late_labels_;     // per window index, valid where stamped
   std::vector<std::uint32_t> late_stamp_;  // per window index
   std::uint32_t late_generation_ = 0;
+  ReachTable from_start_;                    // see distance_from_start
+  std::uint32_t from_start_generation_ = 0;  // generation_ of the search it was set up for
   std::uint32_t sequence_ = 0;
   TimeNs arrival_floor_ = 0;  // no arrival at the last stop can be earlier (see arrival_floor)
   std::size_t floor_pops_ = 0;     // states expanded with the floor as key, since it last rose
