@@ -45,8 +45,8 @@ struct SearchInput {
   std::span<const Leg> legs;
   TimeNs deadline = 0;         ///< states that could only leave later are dropped
   bool count_locks = true;
-  std::size_t floor_proof_after = 256;   ///< PlannerOptions::floor_proof_after
-  std::size_t floor_proof_budget = 256;  ///< PlannerOptions::floor_proof_budget
+  std::size_t floor_proof_after = 512;   ///< PlannerOptions::floor_proof_after
+  std::size_t floor_proof_budget = 128;  ///< PlannerOptions::floor_proof_budget
 };
 
 struct SearchOutcome {

@@ -19,11 +19,13 @@ struct PlannerOptions {
   /// After expanding this many states keyed by the arrival floor (the earliest the last
   /// stop can be entered and held), a search tries to prove that no route arrives that
   /// early and raises the floor (docs/carp.md); four times as many before each further try.
-  /// Any value >= 1 gives the same arrivals; 256 pays off on the benchmark's maps.
-  std::size_t floor_proof_after = 256;
+  /// Any value >= 1 gives the same arrivals; 512 paid off best on the benchmark's maps
+  /// (128, 256, 1024 tried; docs/benchmarks.md).
+  std::size_t floor_proof_after = 512;
   /// How many backward states such a proof may visit before it gives up; four times as many
-  /// at each further try. Any value >= 1 gives the same arrivals.
-  std::size_t floor_proof_budget = 256;
+  /// at each further try. Any value >= 1 gives the same arrivals; 128 paid off best (64,
+  /// 256, 1024 tried).
+  std::size_t floor_proof_budget = 128;
 };
 
 /// What the search of the last Planner::plan call did (for tests and measurements).
