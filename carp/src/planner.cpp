@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "drover/carp/free_path.hpp"
 #include "heuristic.hpp"
 #include "traversal.hpp"
 #include "window_search.hpp"
@@ -133,11 +132,10 @@ struct Planner::Impl {
   std::vector<Leg> legs;
   std::vector<Interval> goal_windows;
   std::vector<Interval> start_windows;
-  FreePathSearch free_paths;  ///< only to name the blockers of a failed search
   PlanStats stats;            ///< of the last plan's search
 
   Impl(std::shared_ptr<const RoutingGraph> g, PlannerOptions o)
-      : graph(std::move(g)), options(o), heuristics(o.heuristic_tables), free_paths(graph) {}
+      : graph(std::move(g)), options(o), heuristics(o.heuristic_tables) {}
 
   const topology::Topology& topology() const { return graph->topology(); }
 
@@ -264,18 +262,29 @@ struct Planner::Impl {
     return failure;
   }
 
-  /// The agents holding open-ended a vertex of the reservation-free fastest path through
-  /// the stops (the start excluded: the vehicle stands there).
-  std::vector<std::string> blockers_on_free_path(const TimelineSet& timelines, const PlanRequest& request) {
+  /// The agents holding open-ended a vertex of a reservation-free fastest path through the
+  /// stops (the start excluded: the vehicle stands there): at each vertex the first usable
+  /// arc, in the graph's order, that the leg's heuristic table says keeps to a fastest path.
+  std::vector<std::string> blockers_on_free_path(const TimelineSet& timelines,
+                                                 const Traversal& traversal,
+                                                 const PlanRequest& request) {
     std::vector<std::string> blockers;
-    EntityIndex from = request.start;
-    for (const Stop& stop : request.stops) {
-      auto path = free_paths.find(request.vehicle, from, stop.vertex);
-      if (!path) break;
-      for (const EntityIndex v : path->vertices) {
-        if (v != request.start) add_open_ended_holders(timelines, v, request.agent, blockers);
+    EntityIndex at = request.start;
+    for (const Leg& leg : legs) {
+      HeuristicTable& table = *leg.table;
+      while (at != leg.stop) {
+        const DurationNs to_go = table.distance(*graph, traversal, at);
+        ArcIndex a = graph->arcs_begin(at);
+        const ArcIndex end = graph->arcs_end(at);
+        while (a != end && (!traversal.usable_arc(a) ||
+                            traversal.travel(a) + table.distance(*graph, traversal,
+                                                                 graph->arc(a).to) != to_go)) {
+          ++a;
+        }
+        if (a == end) break;  // never: prepare_legs found the stop reachable from the start
+        at = graph->arc(a).to;
+        add_open_ended_holders(timelines, at, request.agent, blockers);
       }
-      from = stop.vertex;
     }
     sort_unique(blockers);
     return blockers;
@@ -337,7 +346,7 @@ struct Planner::Impl {
     PlanError failure = error(PlanFailure::no_window,
                               fmt::format("other agents' reservations block every route to {} for good",
                                           vertex_name(goal)));
-    failure.blockers = blockers_on_free_path(timelines, request);
+    failure.blockers = blockers_on_free_path(timelines, *input.traversal, request);
     if (!failure.blockers.empty()) {
       failure.message += fmt::format(" (standing in the way: {})", fmt::join(failure.blockers, ", "));
     }
