@@ -265,7 +265,7 @@ void add_bench_plan_command(CLI::App& bench, cli::CommandContext& context) {
   plan->add_option("--scen", arguments->scenario, "MovingAI .scen file")->required();
   plan->add_option("--agents", arguments->agents, "How many scenario tasks to plan (N >= 1)")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   plan->add_option("--paths", arguments->paths,
                    "Also write one JSON line per agent with its steps to this file");
   plan->add_option("--repeat", arguments->repeat,

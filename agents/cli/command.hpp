@@ -14,6 +14,24 @@ enum ExitCode : int {
   kExitNoAnswer = 3,    ///< no agent answered
 };
 
+/// CLI11 checks of a number's sign with plain messages ("must be > 0, got 0"): CLI11's own
+/// PositiveNumber and NonNegativeNumber name a range from 0 to 1.8e308 instead.
+inline CLI::Validator sign_check(bool zero_allowed) {
+  return CLI::Validator(
+      [zero_allowed](std::string& input) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(input, value)) return "'" + input + "' is not a number";
+        const bool fine = zero_allowed ? value >= 0 : value > 0;
+        return fine ? std::string() : std::string(zero_allowed ? "must be >= 0" : "must be > 0") +
+                                          ", got " + input;
+      },
+      zero_allowed ? "NONNEGATIVE" : "POSITIVE");
+}
+/// The number must be > 0.
+inline CLI::Validator positive() { return sign_check(false); }
+/// The number must be >= 0.
+inline CLI::Validator non_negative() { return sign_check(true); }
+
 /// Filled in by the subcommand that ran.
 struct CommandContext {
   int exit_code = kExitOk;

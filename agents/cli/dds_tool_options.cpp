@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include "agents/cli/command.hpp"
+
 namespace drover::cli {
 
 void add_dds_tool_options(CLI::App& command, DdsToolOptions& options, double default_timeout_seconds) {
@@ -9,7 +11,7 @@ void add_dds_tool_options(CLI::App& command, DdsToolOptions& options, double def
   command.add_option("--domain", options.domain_id, "DDS domain id of the agents (default 0)")
       ->check(CLI::Range(0, 232));
   command.add_option("--timeout", options.timeout_seconds, "Seconds to wait for agents to answer")
-      ->check(CLI::PositiveNumber)
+      ->check(cli::positive())
       ->capture_default_str();
   command.add_option("--xml-profile", options.xml_profile, "Fast DDS XML profiles file (transports, security)")
       ->check(CLI::ExistingFile);

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/routing_agent/route_wire.hpp"
@@ -126,7 +127,7 @@ void add_route_command(CLI::App& app, CommandContext& context) {
                       "Shared-clock start time, ns (default: now on the routing agent's clock)");
   command->add_option("--dwell", arguments->dwell_seconds,
                       "Hold the destination this many seconds (default: open-ended, until the next route)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_option("--for", arguments->owner, "Agent the route is for (default: droverctl-<pid>)");
   add_dds_tool_options(*command, arguments->dds, 5.0);
   command->callback([arguments, &context] { context.exit_code = run_route(*arguments); });

@@ -81,16 +81,16 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
   add_clock_options(*command, arguments->clock);
   command->add_option("--prepare-ttl", arguments->prepare_ttl_seconds,
                       "Shared-clock seconds a prepared hold lives before it expires (default 5)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_option("--max-attempts", arguments->max_attempts,
                       "Plan/prepare rounds of a real route before ERROR_CONFLICT (default 5)")
       ->check(CLI::Range(1, 100));
   command->add_option("--learn-timeout", arguments->learn_timeout_seconds,
                       "Seconds a request waits for the descriptions it needs (default 3)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_option("--horizon", arguments->horizon_seconds,
                       "Planning horizon after the start time, seconds (default 3600)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_flag("--hold-after-prepare", arguments->hold_after_prepare,
                     "TEST HOOK: prepare real routes but never commit them (log a marker and wait)");
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")

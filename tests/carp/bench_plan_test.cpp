@@ -148,7 +148,10 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
        path("missing.map")},
       {{"--map", path("ring.map"), "--scen", path("missing.scen"), "--agents", "1"},
        path("missing.scen")},
-      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "0"}, "--agents"},
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "0"},
+       "--agents: must be > 0, got 0"},
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "two"},
+       "--agents: 'two' is not a number"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.message);

@@ -116,7 +116,7 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
       ->check(CLI::Range(1, 1000));
   command->add_option("--delay-threshold", arguments->delay_threshold,
                       "s of lateness at the next vertex before a delay is propagated (default 2)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_option("--park-after", arguments->park_after,
                       "s idle before driving to a parking vertex; negative: never (default 30)");
   command->add_option("--charge-below", arguments->charge_below,
@@ -125,10 +125,10 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
   command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at (default 0.9)");
   command->add_option("--error-limit", arguments->error_limit,
                       "s a recoverable RAN error may last before the order fails (default 60)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   command->add_option("--route-limit", arguments->route_limit,
                       "s to keep asking for a route the timelines or locks refuse (default 120)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative());
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }

@@ -168,9 +168,9 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--drain", vehicle.drain_wh_per_metre, "Wh per metre driven (default 0.5)");
   sim->add_option("--charge-rate", vehicle.charge_wh_per_second, "Wh per second charging (default 1)");
   sim->add_option("--load-duration", arguments->load_seconds, "s (default 5)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative());
   sim->add_option("--unload-duration", arguments->unload_seconds, "s (default 5)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative());
   sim->add_option("--custom-action", arguments->custom_actions,
                   "A custom action the vehicle supports: NAME=SECONDS (repeatable)");
   sim->add_flag("--loaded", arguments->loaded, "Start loaded");
