@@ -31,14 +31,23 @@ std::vector<pid_t> started_pids(const std::string& output, const std::string& id
   return pids;
 }
 
+/// `drover launch DIR/fleet.json EXTRA...`, its stdout and stderr in DIR/out.txt and
+/// DIR/err.txt.
+std::optional<ChildProcess> start_launch(const std::filesystem::path& dir,
+                                         const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> arguments{"launch", (dir / "fleet.json").string()};
+  arguments.insert(arguments.end(), extra.begin(), extra.end());
+  return ChildProcess::spawn(binary_path("drover"), arguments, (dir / "out.txt").string(),
+                             (dir / "err.txt").string());
+}
+
 TEST(LauncherProcess, StartsPrefixesRestartsAndStopsOnSigterm) {
   const auto dir = scratch_dir("launch_restart");
   write_text(dir / "fleet.json", loop_launch(94, R"(
       {"kind": "topology"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
       {"kind": "ran-sim", "vehicle": "V2", "at": "north-east", "restart": "on-failure", "max_restarts": 3})"));
-  auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
-                                      (dir / "out.txt").string(), (dir / "err.txt").string());
+  auto launcher = start_launch(dir);
   ASSERT_TRUE(launcher.has_value());
   const auto err = dir / "err.txt";
 
@@ -92,8 +101,7 @@ TEST(LauncherProcess, AgentsEndWhenTheLauncherIsKilled) {
   write_text(dir / "fleet.json", loop_launch(79, R"(
       {"kind": "topology"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
-  auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
-                                      (dir / "out.txt").string(), (dir / "err.txt").string());
+  auto launcher = start_launch(dir);
   ASSERT_TRUE(launcher.has_value());
   const auto err = dir / "err.txt";
   ASSERT_TRUE(wait_for_output(err, [](const std::string& text) {
@@ -124,10 +132,7 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto dir = scratch_dir("launch_duration");
   write_text(dir / "fleet.json", loop_launch(95, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
-  auto launcher = ChildProcess::spawn(
-      binary_path("drover"),
-      {"launch", (dir / "fleet.json").string(), "--duration", "30", "--trace", (dir / "trace.jsonl").string()},
-      (dir / "out.txt").string(), (dir / "err.txt").string());
+  auto launcher = start_launch(dir, {"--duration", "30", "--trace", (dir / "trace.jsonl").string()});
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(120s);
   ASSERT_TRUE(status.has_value()) << "the launcher did not stop after --duration";
@@ -151,9 +156,7 @@ TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
   write_text(dir / "fleet.json", loop_launch(96, R"(
       {"kind": "topology", "db": "/nonexistent-dir/loop.db"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
-  auto launcher = ChildProcess::spawn(binary_path("drover"),
-                                      {"launch", (dir / "fleet.json").string(), "--duration", "30"},
-                                      (dir / "out.txt").string(), (dir / "err.txt").string());
+  auto launcher = start_launch(dir, {"--duration", "30"});
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(120s);
   ASSERT_TRUE(status.has_value());
@@ -170,8 +173,7 @@ TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   const auto dir = scratch_dir("launch_bad");
   write_text(dir / "fleet.json", loop_launch(97, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "atlantis"})"));
-  auto launcher = ChildProcess::spawn(binary_path("drover"), {"launch", (dir / "fleet.json").string()},
-                                      (dir / "out.txt").string(), (dir / "err.txt").string());
+  auto launcher = start_launch(dir);
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(60s);
   ASSERT_TRUE(status.has_value());
