@@ -35,7 +35,7 @@ void WindowSearch::begin(const SearchInput& input) {
     entity_first_.assign(entities, 0);
     entity_count_.assign(entities, 0);
     kept_.assign(entities, KeptWindows{});
-    kept_windows_.clear();
+    windows_.clear();
     kept_live_ = 0;
   }
   agent_bit_ = topology::TimelineSet::agent_bit(input.agent);
@@ -44,7 +44,8 @@ void WindowSearch::begin(const SearchInput& input) {
     block_stamp_.resize(blocks, 0);
     block_first_.resize(blocks, 0);
   }
-  windows_.clear();
+  // Only between searches: a search refers to windows by their index.
+  if (windows_.size() > 2 * kept_live_ + 4096) compact_windows();
   states_.clear();
   open_.clear();
   sequence_ = 0;
@@ -59,23 +60,23 @@ void WindowSearch::begin(const SearchInput& input) {
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
-  entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
   const KeptWindows* kept = input.count_locks ? &kept_windows(input, entity) : nullptr;
   if (kept == nullptr || (kept->agents & agent_bit_) != 0) {
     // Locks ignored, or the agent may have reservations there, which never block it.
+    entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
     input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
                                          windows_, input.count_locks);
+    entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
   } else {
-    // Read from an earlier time, they clip to the same windows: a held reservation only
-    // drops the windows before it, and those end before it starts.
-    for (std::uint32_t i = kept->first; i < kept->first + kept->count; ++i) {
-      const Interval window = kept_windows_[i];
-      if (window.end > input.start_time) {
-        windows_.push_back(Interval{std::max(window.start, input.start_time), window.end});
-      }
-    }
+    // The kept windows serve as they are, without those that end by the start time (read
+    // from an earlier time they are the same windows otherwise: a held reservation only
+    // drops the windows before it, and those end before it starts). The first may start
+    // before the start time; the search never gets there before it, and every reader
+    // takes a window start as "free from", so that start only weakens bounds.
+    const std::uint32_t past = ending_after(kept->first, kept->count, input.start_time);
+    entity_first_[entity] = kept->first + past;
+    entity_count_[entity] = kept->count - past;
   }
-  entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
 }
 
 const WindowSearch::KeptWindows& WindowSearch::kept_windows(const SearchInput& input,
@@ -83,25 +84,24 @@ const WindowSearch::KeptWindows& WindowSearch::kept_windows(const SearchInput& i
   KeptWindows& kept = kept_[entity];
   const std::uint64_t revision = input.timelines->windows_revision(entity);
   if (kept.revision == revision && kept.from <= input.start_time) return kept;
-  if (kept_windows_.size() > 2 * kept_live_ + 4096) compact_kept_windows();
   kept_live_ -= kept.count;
   kept.revision = revision;
   kept.from = input.start_time;
-  kept.first = static_cast<std::uint32_t>(kept_windows_.size());
-  kept.agents = input.timelines->append_newcomer_windows(entity, input.start_time, kept_windows_);
-  kept.count = static_cast<std::uint32_t>(kept_windows_.size()) - kept.first;
+  kept.first = static_cast<std::uint32_t>(windows_.size());
+  kept.agents = input.timelines->append_newcomer_windows(entity, input.start_time, windows_);
+  kept.count = static_cast<std::uint32_t>(windows_.size()) - kept.first;
   kept_live_ += kept.count;
   return kept;
 }
 
-void WindowSearch::compact_kept_windows() {
+void WindowSearch::compact_windows() {
   spare_windows_.clear();
   for (KeptWindows& kept : kept_) {
-    const auto begin = kept_windows_.begin() + kept.first;
+    const auto begin = windows_.begin() + kept.first;
     kept.first = static_cast<std::uint32_t>(spare_windows_.size());
     spare_windows_.insert(spare_windows_.end(), begin, begin + kept.count);
   }
-  kept_windows_.swap(spare_windows_);
+  windows_.swap(spare_windows_);
 }
 
 void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
@@ -161,9 +161,11 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   const DurationNs clearance = input.traversal->clearance(arc);
   std::uint32_t count = 0;
   const std::uint32_t first = windows_of(input, input.graph->arc(arc).edge, count);
-  for (std::uint32_t e = 0; e < count && windows_[first + e].start + travel < bound; ++e) {
+  for (std::uint32_t e = 0; e < count; ++e) {
     const Interval edge = windows_[first + e];
-    const TimeNs z = held_after(input, edge.start + travel);
+    const TimeNs onto_edge = std::max(edge.start, input.start_time);
+    if (onto_edge + travel >= bound) break;
+    const TimeNs z = held_after(input, onto_edge + travel);
     if (z != kForever && z + clearance <= edge.end) return z;
   }
   return kForever;
@@ -408,7 +410,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   SearchOutcome outcome;
   std::uint32_t count = 0;
   const std::uint32_t first = windows_of(input, input.start, count);
-  if (count == 0 || windows_[first].start != input.start_time) return outcome;
+  if (count == 0 || windows_[first].start > input.start_time) return outcome;
   outcome.start_free = true;
   // Every state's key is at least this: states that could only reach the goal before it
   // is free would otherwise all be expanded first, in order of a bound that cannot be met.

@@ -146,7 +146,8 @@ class WindowSearch {
   }
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
-  /// The free windows of `entity` from the start time on: indices [first, first + count).
+  /// The free windows of `entity` that end after the start time (the first may start
+  /// before it): indices [first, first + count) of windows_.
   /// Inline: most calls find them read already.
   std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
                            std::uint32_t& count) {
@@ -157,13 +158,19 @@ class WindowSearch {
   /// The offset from `first` of the first of the `count` windows at windows_[first] (sorted,
   /// disjoint, so their ends increase) that ends after `t`; `count` if none does.
   std::uint32_t ending_after(std::uint32_t first, std::uint32_t count, TimeNs t) const {
+    if (count <= 8) {  // most entities have a few windows: a scan beats a binary search
+      std::uint32_t i = 0;
+      while (i < count && windows_[first + i].end <= t) ++i;
+      return i;
+    }
     const auto begin = windows_.begin() + first;
     return static_cast<std::uint32_t>(
         std::partition_point(begin, begin + count,
                              [t](const topology::Interval& w) { return w.end <= t; }) -
         begin);
   }
-  /// Appends the free windows of `entity` to windows_ and records where they are.
+  /// Finds the free windows of `entity` (kept, or appended to windows_) and records where
+  /// they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
   /// The windows of `entity` for an agent without reservations there, as kept between
   /// searches (read again when the timelines revised them, or for an earlier start).
@@ -171,12 +178,12 @@ class WindowSearch {
     std::uint64_t revision = 0;  // TimelineSet::windows_revision when read; 0: never read
     TimeNs from = 0;             // read from this time on
     std::uint64_t agents = 0;    // TimelineSet::agent_bit of the agents with reservations
-    std::uint32_t first = 0;     // index into kept_windows_
+    std::uint32_t first = 0;     // index into windows_
     std::uint32_t count = 0;
   };
   const KeptWindows& kept_windows(const SearchInput& input, topology::EntityIndex entity);
-  /// Drops the windows of kept_windows_ that no entity refers to any more.
-  void compact_kept_windows();
+  /// Drops the windows of windows_ that no entity keeps. Only between searches.
+  void compact_windows();
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex) {
@@ -202,13 +209,14 @@ class WindowSearch {
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
   std::vector<std::uint32_t> block_stamp_, block_first_;
-  std::vector<topology::Interval> windows_;
-  // Free windows kept between searches, per entity: a plan reads thousands of timelines,
-  // and most have not changed since the plan before. Reading one costs a cache miss per
-  // few reservations, copying kept windows almost nothing.
+  // Every window the searches read, in one arena that outlives a search: the free windows
+  // kept per entity between searches (kept_), and the windows each search read for its
+  // own agent. A plan reads thousands of timelines, and most have not changed since the
+  // plan before: reading one costs a cache miss per few reservations, and kept windows
+  // serve in place.
+  std::vector<topology::Interval> windows_, spare_windows_;
   std::vector<KeptWindows> kept_;
-  std::vector<topology::Interval> kept_windows_, spare_windows_;
-  std::size_t kept_live_ = 0;     // windows of kept_windows_ that an entity refers to
+  std::size_t kept_live_ = 0;     // windows of windows_ that an entity keeps
   std::uint64_t agent_bit_ = 0;   // TimelineSet::agent_bit of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
