@@ -29,24 +29,16 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
     distance_[next] = through;
     open_.push(static_cast<std::uint64_t>(through / unit), next);
   };
+  const Traversal::Hops& hops = traversal.hops(graph);
   while (!open_.empty()) {
     const EntityIndex top = open_.pop().value;
     if (closed_[top]) continue;  // stale: popped before
     closed_[top] = 1;
     const DurationNs distance = distance_[top];
-    if constexpr (kDirection == Direction::to_root) {
-      // Backwards: the arcs into top lead from the vertices that can reach it.
-      for (const ArcIndex a : graph.arcs_into(top)) {
-        const EntityIndex from = graph.arc(a).from;
-        if (traversal.usable_arc(a) && traversal.usable_vertex(from)) {
-          relax(from, distance + traversal.travel(a));
-        }
-      }
-    } else if (traversal.usable_vertex(top)) {  // a root the vehicle may not use leads nowhere
-      for (ArcIndex a = graph.arcs_begin(top); a != graph.arcs_end(top); ++a) {
-        if (traversal.usable_arc(a)) relax(graph.arc(a).to, distance + traversal.travel(a));
-      }
-    }
+    // Backwards, the arcs into top lead from the vertices that can reach it; forwards, a
+    // root the vehicle may not use leads nowhere (it has no hops).
+    const auto next = kDirection == Direction::to_root ? hops.into_of(top) : hops.from_of(top);
+    for (const Traversal::Hop& hop : next) relax(hop.vertex, distance + hop.travel);
     if (top == vertex) return distance;
   }
   return kUnreachable;  // every vertex connected with the root is closed, and `vertex` is not

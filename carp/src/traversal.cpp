@@ -91,6 +91,26 @@ void Traversal::find_components(const RoutingGraph& graph) const {
   }
 }
 
+void Traversal::build_hops(const RoutingGraph& graph) const {
+  const std::size_t n = graph.vertex_count();
+  hops_.into_first.assign(n + 1, 0);
+  hops_.from_first.assign(n + 1, 0);
+  for (EntityIndex v = 0; v < n; ++v) {
+    hops_.into_first[v] = static_cast<std::uint32_t>(hops_.into.size());
+    for (const ArcIndex a : graph.arcs_into(v)) {
+      const EntityIndex from = graph.arc(a).from;
+      if (usable_arc(a) && usable_vertex(from)) hops_.into.push_back(Hop{travel(a), from});
+    }
+    hops_.from_first[v] = static_cast<std::uint32_t>(hops_.from.size());
+    if (!usable_vertex(v)) continue;
+    for (ArcIndex a = graph.arcs_begin(v); a != graph.arcs_end(v); ++a) {
+      if (usable_arc(a)) hops_.from.push_back(Hop{travel(a), graph.arc(a).to});
+    }
+  }
+  hops_.into_first[n] = static_cast<std::uint32_t>(hops_.into.size());
+  hops_.from_first[n] = static_cast<std::uint32_t>(hops_.from.size());
+}
+
 bool Traversal::same_class(const VehicleProfile& a, const VehicleProfile& b) {
   return a.max_speed == b.max_speed && a.length == b.length && a.width == b.width &&
          a.payload == b.payload && a.type == b.type;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "drover/carp/routing_graph.hpp"
@@ -43,6 +44,32 @@ class Traversal {
 
   const VehicleProfile& vehicle() const noexcept { return vehicle_; }
 
+  /// A usable arc as the distance searches follow it: the vertex at its other end, and its
+  /// travel time.
+  struct Hop {
+    DurationNs travel;
+    topology::EntityIndex vertex;
+  };
+  /// The usable arcs of each vertex in one flat array, for searches that need only the
+  /// neighbours and the travel times (a third of the loads and branches of the arcs).
+  struct Hops {
+    std::vector<std::uint32_t> into_first, from_first;  // per vertex, and one past the last
+    std::vector<Hop> into, from;
+    /// The usable arcs into `v` from usable vertices, as (source, travel).
+    std::span<const Hop> into_of(topology::EntityIndex v) const {
+      return {into.data() + into_first[v], into.data() + into_first[v + 1]};
+    }
+    /// The usable arcs out of `v`, none when `v` is not usable, as (destination, travel).
+    std::span<const Hop> from_of(topology::EntityIndex v) const {
+      return {from.data() + from_first[v], from.data() + from_first[v + 1]};
+    }
+  };
+  /// Built on the first call (only the planner's distance tables ask, not FreePathSearch).
+  const Hops& hops(const RoutingGraph& graph) const {
+    if (hops_.into_first.empty()) build_hops(graph);
+    return hops_;
+  }
+
   /// True when `a` and `b` lie in one strongly connected component of the usable arcs, so
   /// that the vehicle can drive from either to the other (reservations aside). False says
   /// nothing: b may still be reachable from a.
@@ -58,6 +85,7 @@ class Traversal {
  private:
   /// Fills component_ (Kosaraju, iterative) over the usable arcs.
   void find_components(const RoutingGraph& graph) const;
+  void build_hops(const RoutingGraph& graph) const;
 
   VehicleProfile vehicle_;
   std::vector<DurationNs> travel_;
@@ -67,6 +95,7 @@ class Traversal {
   // Per vertex: its strongly connected component; empty until mutually_reachable needs it
   // (a cache: a traversal is used by one planner, on one thread).
   mutable std::vector<std::uint32_t> component_;
+  mutable Hops hops_;  // empty until hops() needs it (a cache, as component_)
   double ns_per_metre_ = 0;
   DurationNs min_travel_ = 1;
 };

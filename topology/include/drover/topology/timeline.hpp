@@ -250,8 +250,11 @@ class TimelineSet {
     // Hashes the last 8 bytes and the length only: fleet ids differ at their ends
     // ("agv-017"). Two agents sharing a bit only cost a planner an exact query.
     std::uint64_t tail = 0;
-    const std::size_t n = agent.size() < sizeof tail ? agent.size() : sizeof tail;
-    if (n > 0) std::memcpy(&tail, agent.data() + agent.size() - n, n);
+    if (agent.size() >= sizeof tail) {  // a load of fixed size, not a call
+      std::memcpy(&tail, agent.data() + agent.size() - sizeof tail, sizeof tail);
+    } else if (!agent.empty()) {
+      std::memcpy(&tail, agent.data(), agent.size());
+    }
     return std::uint64_t{1} << (((tail ^ agent.size()) * 0x9e3779b97f4a7c15ull) >> 58);
   }
   /// Changes, to a value never returned before in this process for any set, whenever the
