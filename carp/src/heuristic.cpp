@@ -29,16 +29,18 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
     distance_[next] = through;
     open_.push(static_cast<std::uint64_t>(through / unit), next);
   };
-  const Traversal::Hops& hops = traversal.hops(graph);
+  const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
   while (!open_.empty()) {
     const EntityIndex top = open_.pop().value;
     if (closed_[top]) continue;  // stale: popped before
     closed_[top] = 1;
     const DurationNs distance = distance_[top];
-    // Backwards, the arcs into top lead from the vertices that can reach it; forwards, a
-    // root the vehicle may not use leads nowhere (it has no hops).
-    const auto next = kDirection == Direction::to_root ? hops.into_of(top) : hops.from_of(top);
-    for (const Traversal::Hop& hop : next) relax(hop.vertex, distance + hop.travel);
+    if constexpr (kDirection == Direction::to_root) {
+      // Backwards: the arcs into top lead from the vertices that can reach it.
+      for (const Traversal::Hop& hop : adjacency.into_of(top)) relax(hop.from, distance + hop.travel);
+    } else {  // a root the vehicle may not use leads nowhere (it has no moves)
+      for (const Traversal::Move& move : adjacency.out_of(top)) relax(move.to, distance + move.travel);
+    }
     if (top == vertex) return distance;
   }
   return kUnreachable;  // every vertex connected with the root is closed, and `vertex` is not

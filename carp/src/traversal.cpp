@@ -91,24 +91,27 @@ void Traversal::find_components(const RoutingGraph& graph) const {
   }
 }
 
-void Traversal::build_hops(const RoutingGraph& graph) const {
+void Traversal::build_adjacency(const RoutingGraph& graph) const {
   const std::size_t n = graph.vertex_count();
-  hops_.into_first.assign(n + 1, 0);
-  hops_.from_first.assign(n + 1, 0);
+  Adjacency& adjacency = adjacency_;
+  adjacency.into_first.assign(n + 1, 0);
+  adjacency.out_first.assign(n + 1, 0);
   for (EntityIndex v = 0; v < n; ++v) {
-    hops_.into_first[v] = static_cast<std::uint32_t>(hops_.into.size());
+    adjacency.into_first[v] = static_cast<std::uint32_t>(adjacency.into.size());
     for (const ArcIndex a : graph.arcs_into(v)) {
       const EntityIndex from = graph.arc(a).from;
-      if (usable_arc(a) && usable_vertex(from)) hops_.into.push_back(Hop{travel(a), from});
+      if (usable_arc(a) && usable_vertex(from)) adjacency.into.push_back(Hop{travel(a), from});
     }
-    hops_.from_first[v] = static_cast<std::uint32_t>(hops_.from.size());
+    adjacency.out_first[v] = static_cast<std::uint32_t>(adjacency.out.size());
     if (!usable_vertex(v)) continue;
     for (ArcIndex a = graph.arcs_begin(v); a != graph.arcs_end(v); ++a) {
-      if (usable_arc(a)) hops_.from.push_back(Hop{travel(a), graph.arc(a).to});
+      if (!usable_arc(a)) continue;
+      const Arc& arc = graph.arc(a);
+      adjacency.out.push_back(Move{travel(a), clearance(a), a, arc.edge, arc.to});
     }
   }
-  hops_.into_first[n] = static_cast<std::uint32_t>(hops_.into.size());
-  hops_.from_first[n] = static_cast<std::uint32_t>(hops_.from.size());
+  adjacency.into_first[n] = static_cast<std::uint32_t>(adjacency.into.size());
+  adjacency.out_first[n] = static_cast<std::uint32_t>(adjacency.out.size());
 }
 
 bool Traversal::same_class(const VehicleProfile& a, const VehicleProfile& b) {

@@ -44,30 +44,38 @@ class Traversal {
 
   const VehicleProfile& vehicle() const noexcept { return vehicle_; }
 
-  /// A usable arc as the distance searches follow it: the vertex at its other end, and its
-  /// travel time.
+  /// A usable arc into a vertex from a usable one, as the backward distance search
+  /// follows it.
   struct Hop {
     DurationNs travel;
-    topology::EntityIndex vertex;
+    topology::EntityIndex from;
   };
-  /// The usable arcs of each vertex in one flat array, for searches that need only the
-  /// neighbours and the travel times (a third of the loads and branches of the arcs).
-  struct Hops {
-    std::vector<std::uint32_t> into_first, from_first;  // per vertex, and one past the last
-    std::vector<Hop> into, from;
-    /// The usable arcs into `v` from usable vertices, as (source, travel).
+  /// A usable arc out of a usable vertex, with what a search needs to drive it.
+  struct Move {
+    DurationNs travel;
+    DurationNs clearance;
+    ArcIndex arc;
+    topology::EntityIndex edge;
+    topology::EntityIndex to;
+  };
+  /// The usable arcs of every vertex in flat arrays, for the searches' inner loops: one
+  /// contiguous read per vertex instead of the arcs, their times and their usability.
+  struct Adjacency {
+    std::vector<std::uint32_t> into_first, out_first;  // per vertex, and one past the last
+    std::vector<Hop> into;
+    std::vector<Move> out;
     std::span<const Hop> into_of(topology::EntityIndex v) const {
       return {into.data() + into_first[v], into.data() + into_first[v + 1]};
     }
-    /// The usable arcs out of `v`, none when `v` is not usable, as (destination, travel).
-    std::span<const Hop> from_of(topology::EntityIndex v) const {
-      return {from.data() + from_first[v], from.data() + from_first[v + 1]};
+    /// None when `v` is not usable.
+    std::span<const Move> out_of(topology::EntityIndex v) const {
+      return {out.data() + out_first[v], out.data() + out_first[v + 1]};
     }
   };
-  /// Built on the first call (only the planner's distance tables ask, not FreePathSearch).
-  const Hops& hops(const RoutingGraph& graph) const {
-    if (hops_.into_first.empty()) build_hops(graph);
-    return hops_;
+  /// Built on the first call (only the planner asks, not FreePathSearch).
+  const Adjacency& adjacency(const RoutingGraph& graph) const {
+    if (adjacency_.into_first.empty()) build_adjacency(graph);
+    return adjacency_;
   }
 
   /// True when `a` and `b` lie in one strongly connected component of the usable arcs, so
@@ -85,7 +93,7 @@ class Traversal {
  private:
   /// Fills component_ (Kosaraju, iterative) over the usable arcs.
   void find_components(const RoutingGraph& graph) const;
-  void build_hops(const RoutingGraph& graph) const;
+  void build_adjacency(const RoutingGraph& graph) const;
 
   VehicleProfile vehicle_;
   std::vector<DurationNs> travel_;
@@ -95,7 +103,7 @@ class Traversal {
   // Per vertex: its strongly connected component; empty until mutually_reachable needs it
   // (a cache: a traversal is used by one planner, on one thread).
   mutable std::vector<std::uint32_t> component_;
-  mutable Hops hops_;  // empty until hops() needs it (a cache, as component_)
+  mutable Adjacency adjacency_;  // empty until adjacency() needs it (a cache, as component_)
   double ns_per_metre_ = 0;
   DurationNs min_travel_ = 1;
 };

@@ -358,16 +358,15 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
 }
 
 void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
-                         ArcIndex arc, SearchOutcome& outcome) {
-  const Arc& a = input.graph->arc(arc);
-  const DurationNs travel = input.traversal->travel(arc);
-  const DurationNs clearance = input.traversal->clearance(arc);
+                         const Traversal::Move& move, SearchOutcome& outcome) {
+  const DurationNs travel = move.travel;
+  const DurationNs clearance = move.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
   const TimeNs latest_onto_edge = windows_[current.window].end - clearance;
   if (current.ready > latest_onto_edge) return;
 
   std::uint32_t edge_count = 0, vertex_count = 0;
-  const std::uint32_t edge_first = windows_of(input, a.edge, edge_count);
+  const std::uint32_t edge_first = windows_of(input, move.edge, edge_count);
   // The destination's windows are read only once the edge is known to lead somewhere:
   // reading a timeline is the dearest part of a move.
   std::uint32_t vertex_first = kNone;
@@ -380,7 +379,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     const TimeNs earliest_arrival = onto_edge + travel;
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
-    if (vertex_first == kNone) vertex_first = windows_of(input, a.to, vertex_count);
+    if (vertex_first == kNone) vertex_first = windows_of(input, move.to, vertex_count);
     for (std::uint32_t j = ending_after(vertex_first, vertex_count, earliest_arrival);
          j < vertex_count; ++j) {
       const Interval window = windows_[vertex_first + j];
@@ -390,11 +389,11 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
         outcome.horizon_cut = true;
         break;  // later windows are later still
       }
-      if (block == kNone) block = states_of(input, current.layer, a.to);
+      if (block == kNone) block = states_of(input, current.layer, move.to);
       if (arrival >= states_[block + j].ready) continue;
-      if (to_go < 0) to_go = estimate(input, current.layer, a.to);
+      if (to_go < 0) to_go = estimate(input, current.layer, move.to);
       if (to_go == kUnreachable) return;
-      improve(block + j, arrival, arrival, from, arc, onto_edge, to_go);
+      improve(block + j, arrival, arrival, from, move.arc, onto_edge, to_go);
     }
   }
 }
@@ -446,8 +445,6 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 
 void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const State& current,
                           SearchOutcome& outcome) {
-  const RoutingGraph& graph = *input.graph;
-  const Traversal& traversal = *input.traversal;
   const EntityIndex vertex = current.vertex;
   const TimeNs window_end = windows_[current.window].end;
   const Leg& leg = input.legs[current.layer];
@@ -463,8 +460,8 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
               kNone, 0, next_estimate);
     }
   }
-  for (ArcIndex a = graph.arcs_begin(vertex); a != graph.arcs_end(vertex); ++a) {
-    if (traversal.usable_arc(a)) drive(input, index, current, a, outcome);
+  for (const Traversal::Move& move : input.traversal->adjacency(*input.graph).out_of(vertex)) {
+    drive(input, index, current, move, outcome);
   }
 }
 

@@ -196,10 +196,10 @@ class WindowSearch {
                   topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
-  /// Drives arc `arc` from state `from` (`current`, a copy: states_ may grow) into every
+  /// Drives `move` from state `from` (`current`, a copy: states_ may grow) into every
   /// window of its destination it can reach.
-  void drive(const SearchInput& input, std::uint32_t from, const State& current, ArcIndex arc,
-             SearchOutcome& outcome);
+  void drive(const SearchInput& input, std::uint32_t from, const State& current,
+             const Traversal::Move& move, SearchOutcome& outcome);
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
                std::uint32_t arc, TimeNs edge_entry, DurationNs estimate);
   bool completes(const SearchInput& input, const State& state) const;
