@@ -9,10 +9,9 @@ using topology::EntityIndex;
 template <Direction kDirection>
 void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex root) {
   root_ = root;
-  distance_.assign(graph.vertex_count(), kUnreachable);
-  closed_.assign(graph.vertex_count(), 0);
+  label_.assign(graph.vertex_count(), kUnreachable);
   open_.clear();
-  distance_[root] = 0;
+  label_[root] = 0;
   open_.push(0, root);
 }
 
@@ -25,16 +24,16 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
   // uniform grids the keys are small integers, and the radix heap hardly moves an item.
   const DurationNs unit = traversal.min_travel();
   const auto relax = [&](EntityIndex next, DurationNs through) {
-    if (closed_[next] || through >= distance_[next]) return;
-    distance_[next] = through;
+    if (through >= label_[next]) return;  // closed, or no better
+    label_[next] = through;
     open_.push(static_cast<std::uint64_t>(through / unit), next);
   };
   const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
   while (!open_.empty()) {
     const EntityIndex top = open_.pop().value;
-    if (closed_[top]) continue;  // stale: popped before
-    closed_[top] = 1;
-    const DurationNs distance = distance_[top];
+    const DurationNs distance = label_[top];
+    if (distance < 0) continue;  // stale: popped before
+    label_[top] = ~distance;
     if constexpr (kDirection == Direction::to_root) {
       // Backwards: the arcs into top lead from the vertices that can reach it.
       for (const Traversal::Hop& hop : adjacency.into_of(top)) relax(hop.from, distance + hop.travel);

@@ -45,7 +45,8 @@ class DistanceTable {
   /// for a near vertex is cheap. \pre the same traversal since reset
   DurationNs distance(const RoutingGraph& graph, const Traversal& traversal,
                       topology::EntityIndex vertex) {
-    return closed_[vertex] ? distance_[vertex] : resume(graph, traversal, vertex);
+    const DurationNs label = label_[vertex];
+    return label < 0 ? ~label : resume(graph, traversal, vertex);
   }
 
  private:
@@ -53,8 +54,10 @@ class DistanceTable {
                     topology::EntityIndex vertex);
 
   topology::EntityIndex root_ = topology::kNoEntity;
-  std::vector<DurationNs> distance_;
-  std::vector<std::uint8_t> closed_;
+  // Per vertex: the best distance found, kUnreachable if none, or ~distance (< 0) once the
+  // vertex is closed; one array, so that a relaxation's test of both is one load (a closed
+  // label is below every distance).
+  std::vector<DurationNs> label_;
   RadixHeap<topology::EntityIndex> open_;  // keyed by distance; stale entries are skipped
 };
 
