@@ -35,7 +35,8 @@ enum class Direction {
 template <Direction kDirection>
 class DistanceTable {
  public:
-  /// Starts over for `root` (reusing the memory).
+  /// Starts over for `root` (reusing the memory). \pre the vehicle class may use `root`
+  /// (the planner checks starts and stops first); its distance is 0 all the same.
   void reset(const RoutingGraph& graph, topology::EntityIndex root);
   topology::EntityIndex root() const noexcept { return root_; }
 

@@ -1,8 +1,9 @@
 // The planner's distance tables (the heuristic, and the floor proofs' times from the start)
 // against an independent search: on random grids whose arcs take uneven times (real
-// lengths, several speed limits, one-way edges), the distance to or from the root they give
-// every vertex is FreePathSearch's fastest travel time, whatever order the vertices are
-// asked in (a table resumes its search on demand).
+// lengths, several speed limits, one-way edges) and whose cells and edges the vehicle may
+// not all use (its type forbidden there), the distance to or from the root they give every
+// vertex is FreePathSearch's fastest travel time, whatever order the vertices are asked in
+// (a table resumes its search on demand, over the traversal's flat adjacency).
 
 #include <algorithm>
 #include <random>
@@ -22,8 +23,13 @@ topology::Topology uneven_grid(std::mt19937& rng) {
   const int width = std::uniform_int_distribution<int>(2, 8)(rng);
   const int height = std::uniform_int_distribution<int>(2, 8)(rng);
   GridBuilder g;
+  const auto maybe_forbidden = [&] {
+    topology::Restrictions restrictions;
+    if (coin(rng) < 0.08) restrictions.forbidden_vehicle_types = {"agv"};
+    return restrictions;
+  };
   for (int x = 0; x < width; ++x) {
-    for (int y = 0; y < height; ++y) g.cell(x, y);
+    for (int y = 0; y < height; ++y) g.cell(x, y, maybe_forbidden());
   }
   const auto maybe_edge = [&](int x1, int y1, int x2, int y2) {
     if (x2 >= width || y2 >= height || coin(rng) < 0.15) return;
@@ -31,6 +37,7 @@ topology::Topology uneven_grid(std::mt19937& rng) {
     options.length = length(rng);
     options.max_speed = std::array{0.5, 1.0, 1.7}[std::uniform_int_distribution<int>(0, 2)(rng)];
     options.bidirectional = coin(rng) < 0.8;
+    options.restrictions = maybe_forbidden();
     if (!options.bidirectional && coin(rng) < 0.5) {
       std::swap(x1, x2);
       std::swap(y1, y2);
@@ -61,7 +68,12 @@ TEST(DistanceTable, GivesTheFastestTravelTimeBetweenTheRootAndEveryVertex) {
     HeuristicTable to_table;  // each reused, as the cache and the search do
     ReachTable from_table;
     for (int root_trial = 0; root_trial < 4; ++root_trial) {
-      const auto root = static_cast<topology::EntityIndex>(rng() % n);
+      // A root the vehicle may use, as the planner's (it checks starts and stops first).
+      auto root = static_cast<topology::EntityIndex>(rng() % n);
+      for (std::size_t tries = 0; tries < n && !traversal.usable_vertex(root); ++tries) {
+        root = static_cast<topology::EntityIndex>((root + 1) % n);
+      }
+      if (!traversal.usable_vertex(root)) continue;
       const bool to_root = root_trial % 2 == 0;
       if (to_root) {
         to_table.reset(*graph, root);
