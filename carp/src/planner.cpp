@@ -274,15 +274,12 @@ struct Planner::Impl {
       HeuristicTable& table = *leg.table;
       while (at != leg.stop) {
         const DurationNs to_go = table.distance(*graph, traversal, at);
-        ArcIndex a = graph->arcs_begin(at);
-        const ArcIndex end = graph->arcs_end(at);
-        while (a != end && (!traversal.usable_arc(a) ||
-                            traversal.travel(a) + table.distance(*graph, traversal,
-                                                                 graph->arc(a).to) != to_go)) {
-          ++a;
-        }
-        if (a == end) break;  // never: prepare_legs found the stop reachable from the start
-        at = graph->arc(a).to;
+        const auto moves = traversal.adjacency(*graph).out_of(at);
+        const auto next = std::find_if(moves.begin(), moves.end(), [&](const Traversal::Move& m) {
+          return m.travel + table.distance(*graph, traversal, m.to) == to_go;
+        });
+        if (next == moves.end()) break;  // never: prepare_legs found the stop reachable
+        at = next->to;
         add_open_ended_holders(timelines, at, request.agent, blockers);
       }
     }
