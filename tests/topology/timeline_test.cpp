@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -181,6 +182,31 @@ TEST_F(TimelineTest, PrepareRejectsMalformedRequestsWithInvalidArgument) {
   items[0].entity = 99;
   items[2].window = Interval{5, 1};
   expect_invalid(items, "malformed and unknown");
+}
+
+TEST_F(TimelineTest, RejectionsNameTheItemAndWhatItMeets) {
+  ASSERT_TRUE(set.reserve("bob", 1, {at(2, 0, 10)}));
+  const auto good = set.expand("amy", 1, {at(0, 0, 10), at(2, 8, 20)});
+  const auto contains = [](const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+  };
+  const auto message = [&](const std::vector<Reservation>& items) {
+    const auto result = set.prepare(items, {}, 100);
+    return result ? std::string("accepted") : result.error().message;
+  };
+  auto items = good;
+  items.push_back(good.back());
+  EXPECT_PRED2(contains, message(items), std::string("item " + std::to_string(good.size()) +
+                                                 " (entity " +
+                                                 std::to_string(good.back().entity)));
+  EXPECT_PRED2(contains, message(items), std::string("appears twice"));
+  items = good;
+  items[1].window = Interval{0, 11};
+  EXPECT_PRED2(contains, message(items), std::string("item 1 "));
+  EXPECT_PRED2(contains, message(items), std::string("its step has origin 0 [0, 10) in item 0"));
+  // Well formed, but amy's second step meets bob on entity 2.
+  EXPECT_PRED2(contains, message(good), std::string("prepare: item "));
+  EXPECT_PRED2(contains, message(good), std::string("overlaps agent bob route 1 step 0 [0, 10)"));
 }
 
 TEST_F(TimelineTest, PrepareReportsUnknownEntitiesAndConflictsInThatOrder) {
