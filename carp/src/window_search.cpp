@@ -38,7 +38,7 @@ void WindowSearch::begin(const SearchInput& input) {
     windows_.clear();
     kept_live_ = 0;
   }
-  agent_bit_ = topology::TimelineSet::agent_bit(input.agent);
+  agent_slot_ = topology::TimelineSet::AgentBits::slot(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
@@ -61,7 +61,7 @@ void WindowSearch::begin(const SearchInput& input) {
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
   const KeptWindows* kept = input.count_locks ? &kept_windows(input, entity) : nullptr;
-  if (kept == nullptr || (kept->agents & agent_bit_) != 0) {
+  if (kept == nullptr || kept->agents.may_contain(agent_slot_)) {
     // Locks ignored, or the agent may have reservations there, which never block it.
     entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
     input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,

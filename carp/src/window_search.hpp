@@ -177,7 +177,7 @@ class WindowSearch {
   struct KeptWindows {
     std::uint64_t revision = 0;  // TimelineSet::windows_revision when read; 0: never read
     TimeNs from = 0;             // read from this time on
-    std::uint64_t agents = 0;    // TimelineSet::agent_bit of the agents with reservations
+    topology::TimelineSet::AgentBits agents;  // the agents with reservations there
     std::uint32_t first = 0;     // index into windows_
     std::uint32_t count = 0;
   };
@@ -217,7 +217,7 @@ class WindowSearch {
   std::vector<topology::Interval> windows_, spare_windows_;
   std::vector<KeptWindows> kept_;
   std::size_t kept_live_ = 0;     // windows of windows_ that an entity keeps
-  std::uint64_t agent_bit_ = 0;   // TimelineSet::agent_bit of the search's agent
+  std::uint8_t agent_slot_ = 0;   // TimelineSet::AgentBits::slot of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
   /// The label of a state of prove_late's backward search: the latest time the vehicle may

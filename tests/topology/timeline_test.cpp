@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <utility>
@@ -366,9 +367,32 @@ TEST_F(TimelineTest, NewcomerWindowsAreThoseOfAnAgentWithoutReservationsThere) {
   ASSERT_TRUE(set.reserve("amy", 1, {at(0, 10, 20)}));
   ASSERT_TRUE(set.lock(1, {30, 40}, "op", "spill"));
   std::vector<Interval> out;
-  const std::uint64_t agents = set.append_newcomer_windows(0, 5, out);
+  const TimelineSet::AgentBits agents = set.append_newcomer_windows(0, 5, out);
   EXPECT_EQ(out, set.free_windows(0, "bob", 5, kForever));
-  EXPECT_EQ(agents, TimelineSet::agent_bit("amy"));
+  TimelineSet::AgentBits amy;
+  amy.add(TimelineSet::AgentBits::slot("amy"));
+  EXPECT_EQ(agents, amy);
+  EXPECT_TRUE(agents.may_contain(TimelineSet::AgentBits::slot("amy")));
+}
+
+TEST(AgentBits, FleetIdsSpreadOverTheBits) {
+  // Ids that differ only in their last digits, as a fleet's do, must not crowd a few bits:
+  // a planner makes an exact query for every entity where its bit is taken.
+  std::vector<int> count(256, 0);
+  for (int i = 0; i < 400; ++i) {
+    ++count[TimelineSet::AgentBits::slot("agent-" + std::to_string(i))];
+  }
+  const int used = static_cast<int>(std::count_if(count.begin(), count.end(), [](int c) { return c > 0; }));
+  EXPECT_GE(used, 200);  // 400 ids thrown at random into 256 bits fill about 203
+  EXPECT_LE(*std::max_element(count.begin(), count.end()), 8);
+  TimelineSet::AgentBits bits;
+  bits.add(TimelineSet::AgentBits::slot("agv-017"));
+  EXPECT_TRUE(bits.may_contain(TimelineSet::AgentBits::slot("agv-017")));
+  int shared = 0;
+  for (int i = 0; i < 400; ++i) {
+    shared += bits.may_contain(TimelineSet::AgentBits::slot("agv-" + std::to_string(1000 + i)));
+  }
+  EXPECT_LE(shared, 6);
 }
 
 TEST_F(TimelineTest, WindowsRevisionsMoveWhenWhatFreeWindowsReadChanges) {

@@ -82,11 +82,11 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
               [agent](const Reservation& r) { return same_agent(r.agent, agent); });
 }
 
-std::uint64_t TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs from,
-                                                   std::vector<Interval>& out) const {
-  std::uint64_t agents = 0;
+TimelineSet::AgentBits TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs from,
+                                                           std::vector<Interval>& out) const {
+  AgentBits agents;
   Impl::sweep(*this, entity, from, kForever, out, true, [&agents](const Reservation& r) {
-    agents |= agent_bit(r.agent);
+    agents.add(AgentBits::slot(r.agent));
     return false;
   });
   return agents;
