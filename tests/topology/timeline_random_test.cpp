@@ -391,6 +391,14 @@ class RandomRun {
     last_ = "free_windows " + agent + " " + std::to_string(entity);
     const auto got = set_.free_windows(entity, agent, from, until);
     EXPECT_EQ(got, ref_.free_windows(entity, agent, from, until));
+    // A newcomer's windows (what planners keep between plans) after every kind of change,
+    // and the agents said to have reservations there: all of them.
+    std::vector<Interval> newcomer;
+    const TimelineSet::AgentBits agents = set_.append_newcomer_windows(entity, from, newcomer);
+    EXPECT_EQ(newcomer, ref_.free_windows(entity, "newcomer", from, kForever));
+    for (const Reservation& r : set_.timeline(entity).reservations) {
+      EXPECT_TRUE(agents.may_contain(TimelineSet::AgentBits::slot(r.agent))) << r.agent;
+    }
     for (std::size_t i = 0; i < got.size(); ++i) {  // sorted, disjoint, maximal, inside
       EXPECT_TRUE(got[i].valid());
       EXPECT_GE(got[i].start, from);

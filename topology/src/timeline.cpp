@@ -53,7 +53,18 @@ void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touche
   const std::uint64_t revision = next_revision();
   for (EntityIndex entity : touched) {
     ++set.timelines_[entity].version;
-    set.revisions_.of[entity] = revision;
+    revise(set, entity, revision);
+  }
+}
+
+void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision) {
+  set.revisions_.of[entity] = revision;
+  std::vector<Blocker>& blockers = set.blockers_.of[entity];
+  blockers.clear();
+  for (const Reservation& r : set.timelines_[entity].reservations) {
+    blockers.push_back(Blocker{r.window, AgentBits::slot(r.agent),
+                               r.origin < set.held_.size() && set.held_[r.origin] &&
+                                   is_held(set, r)});
   }
 }
 
@@ -64,8 +75,8 @@ std::uint64_t TimelineSet::Impl::next_revision() {
 
 void TimelineSet::Impl::revise_around(TimelineSet& set, EntityIndex entity) {
   const std::uint64_t revision = next_revision();
-  set.revisions_.of[entity] = revision;
-  for (EntityIndex f : set.conflict_sets_[entity]) set.revisions_.of[f] = revision;
+  revise(set, entity, revision);
+  for (EntityIndex f : set.conflict_sets_[entity]) revise(set, f, revision);
 }
 
 bool TimelineSet::Impl::in_conflict_set(const TimelineSet& set, EntityIndex origin,
@@ -102,7 +113,8 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
       owned_(owned_flags(std::move(owned), conflict_sets_.size())),
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
-      revisions_{std::vector<std::uint64_t>(conflict_sets_.size(), Impl::next_revision())} {}
+      revisions_{std::vector<std::uint64_t>(conflict_sets_.size(), Impl::next_revision())},
+      blockers_{std::vector<std::vector<Blocker>>(conflict_sets_.size())} {}
 
 std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }
 

@@ -45,7 +45,7 @@ void TimelineSet::widen_to_step_hulls() {
     }
     if (!widened) continue;
     Impl::sort_reservations(timeline);
-    revisions_.of[entity] = Impl::next_revision();  // other windows, same version
+    Impl::revise(*this, entity, Impl::next_revision());  // other windows, same version
   }
 }
 
