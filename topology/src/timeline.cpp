@@ -4,6 +4,7 @@
 // in timeline_query.cpp.
 
 #include <algorithm>
+#include <limits>
 #include <atomic>
 #include <cassert>
 #include <functional>
@@ -57,17 +58,6 @@ void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touche
   }
 }
 
-void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision) {
-  set.revisions_.of[entity] = revision;
-  std::vector<Blocker>& blockers = set.blockers_.of[entity];
-  blockers.clear();
-  for (const Reservation& r : set.timelines_[entity].reservations) {
-    blockers.push_back(Blocker{r.window, AgentBits::slot(r.agent),
-                               r.origin < set.held_.size() && set.held_[r.origin] &&
-                                   is_held(set, r)});
-  }
-}
-
 std::uint64_t TimelineSet::Impl::next_revision() {
   static std::atomic<std::uint64_t> last{0};
   return last.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -114,7 +104,13 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
       revisions_{std::vector<std::uint64_t>(conflict_sets_.size(), Impl::next_revision())},
-      blockers_{std::vector<std::vector<Blocker>>(conflict_sets_.size())} {}
+      newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size())} {
+  for (EntityIndex e = 0; e < conflict_sets_.size(); ++e) {
+    if (owns(e)) {
+      newcomers_.of[e].windows.push_back(Interval{std::numeric_limits<TimeNs>::min(), kForever});
+    }
+  }
+}
 
 std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }
 

@@ -27,16 +27,14 @@ struct TimelineSet::Impl {
   /// change of its locks or of who holds it: their free windows read the entity's locks,
   /// and whether the reservations standing for it (real and shadows) are held.
   static void revise_around(TimelineSet& set, EntityIndex entity);
-  /// Gives `entity` windows revision `revision` and refreshes what derives from its
-  /// timeline with it (its blockers). Every change of what free windows read goes through
+  /// Gives `entity` windows revision `revision` and recomputes what derives from its
+  /// timeline (a newcomer's windows). Every change of what free windows read goes through
   /// here, after the change.
   static void revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision);
-  /// The free-window sweep over `items` (the entity's reservations, or its blockers):
-  /// `skip(item)` leaves an item out, `held(item)` tells one that nobody may come before.
-  template <class Items, class Skip, class Held>
-  static void sweep(const TimelineSet& set, EntityIndex entity, const Items& items, TimeNs from,
-                    TimeNs until, std::vector<Interval>& out, bool count_locks, Skip skip,
-                    Held held);
+  /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.
+  template <class Skip>
+  static void sweep(const TimelineSet& set, EntityIndex entity, TimeNs from, TimeNs until,
+                    std::vector<Interval>& out, bool count_locks, Skip skip);
 
   static bool in_conflict_set(const TimelineSet& set, EntityIndex origin, EntityIndex entity);
   /// True when reservations standing for origins a and b may not overlap in time if they

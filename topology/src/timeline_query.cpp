@@ -12,6 +12,7 @@
 // enough"). A held (allocated) reservation blocks from `from` on: nobody comes before it.
 
 #include <algorithm>
+#include <limits>
 
 #include "drover/topology/timeline.hpp"
 #include "timeline_impl.hpp"
@@ -43,23 +44,25 @@ void cut_from(std::vector<Interval>& out, std::size_t base, Interval cut) {
 
 }  // namespace
 
-template <class Items, class Skip, class Held>
-void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, const Items& items,
-                              TimeNs from, TimeNs until, std::vector<Interval>& out,
-                              bool count_locks, Skip skip, Held held) {
+template <class Skip>
+void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, TimeNs from,
+                              TimeNs until, std::vector<Interval>& out, bool count_locks,
+                              Skip skip) {
   if (!set.owns(entity) || from >= until) return;
   // One sweep over the reservations, which are sorted by start: a window ends where the
   // next blocker starts. Then the locks, rare, are cut out.
   const std::size_t base = out.size();
   TimeNs cursor = from;  // the end of everything blocked so far
-  for (const auto& item : items) {
-    if (skip(item)) continue;
-    if (item.window.start > from && held(item)) {
+  for (const Reservation& r : set.timelines_[entity].reservations) {
+    if (skip(r)) continue;
+    // Most reservations' origins are not held at all: that is checked first, inline.
+    if (r.window.start > from && r.origin < set.held_.size() && set.held_[r.origin] &&
+        is_held(set, r)) {
       out.resize(base);  // nobody may come before a holder
-    } else if (item.window.start > cursor && cursor < until) {
-      out.push_back(Interval{cursor, std::min(item.window.start, until)});
+    } else if (r.window.start > cursor && cursor < until) {
+      out.push_back(Interval{cursor, std::min(r.window.start, until)});
     }
-    cursor = std::max(cursor, item.window.end);
+    cursor = std::max(cursor, r.window.end);
   }
   if (cursor < until) out.push_back(Interval{cursor, until});
   if (count_locks && set.lock_count_ > 0) {
@@ -76,27 +79,35 @@ void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, const 
 void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                                       TimeNs until, std::vector<Interval>& out,
                                       bool count_locks) const {
-  Impl::sweep(
-      *this, entity, timelines_[entity].reservations, from, until, out, count_locks,
-      [agent](const Reservation& r) { return same_agent(r.agent, agent); },
-      [this](const Reservation& r) {
-        // Most reservations' origins are not held at all: that is checked first, inline.
-        return r.origin < held_.size() && held_[r.origin] && Impl::is_held(*this, r);
-      });
+  Impl::sweep(*this, entity, from, until, out, count_locks,
+              [agent](const Reservation& r) { return same_agent(r.agent, agent); });
+}
+
+void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision) {
+  set.revisions_.of[entity] = revision;
+  NewcomerWindows& newcomer = set.newcomers_.of[entity];
+  newcomer.windows.clear();
+  newcomer.agents = AgentBits{};
+  sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, newcomer.windows, true,
+        [&newcomer](const Reservation& r) {
+          newcomer.agents.add(AgentBits::slot(r.agent));
+          return false;
+        });
 }
 
 TimelineSet::AgentBits TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs from,
                                                            std::vector<Interval>& out) const {
-  AgentBits agents;
-  if (entity >= blockers_.of.size()) return agents;  // not an entity of this set
-  Impl::sweep(
-      *this, entity, blockers_.of[entity], from, kForever, out, true,
-      [&agents](const Blocker& b) {
-        agents.add(b.slot);
-        return false;
-      },
-      [](const Blocker& b) { return b.held; });
-  return agents;
+  if (!owns(entity)) return AgentBits{};
+  // The windows from the beginning of time, clipped: a sweep from `from` finds the same
+  // ones, except those ending by then (a holder starting by then only dropped windows that
+  // end before it, and a lock cut commutes with the clip).
+  const NewcomerWindows& newcomer = newcomers_.of[entity];
+  const auto first = std::partition_point(newcomer.windows.begin(), newcomer.windows.end(),
+                                          [from](const Interval& w) { return w.end <= from; });
+  for (auto w = first; w != newcomer.windows.end(); ++w) {
+    out.push_back(Interval{std::max(w->start, from), w->end});
+  }
+  return newcomer.agents;
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

@@ -452,21 +452,22 @@ class TimelineSet {
     friend bool operator==(const Revisions&, const Revisions&) { return true; }
   };
   Revisions revisions_;
-  // Per entity, its reservations as a newcomer's free-window query reads them (timeline
-  // order): a third of a Reservation's bytes and no lookup of the origin's holder, since
-  // that query is memory-bound (bench plan: a fifth of the planner's time, most of it
-  // cache misses on reservations and holders). Refreshed with the windows revision (every
-  // change of what free windows read moves it). Derived: equal sets may differ in it.
-  struct Blocker {
-    Interval window;
-    std::uint8_t slot = 0;  // AgentBits::slot of its agent
-    bool held = false;      // held, so nobody may come before it
+  // Per entity, the answer of a newcomer's free-window query from the beginning of time
+  // (append_newcomer_windows clips it), recomputed with the windows revision (every change
+  // of what free windows read moves it). Planners ask it after every change of the
+  // timelines they read, and sweeping the reservations then was memory-bound (bench plan:
+  // a fifth of the planner's time, most of it cache misses on reservations and holders);
+  // the revision moves once per change, in the same pass over the timeline that changed.
+  // Derived: equal sets may differ in it.
+  struct NewcomerWindows {
+    std::vector<Interval> windows;
+    AgentBits agents;  // the agents with a reservation there
   };
-  struct Blockers {
-    std::vector<std::vector<Blocker>> of;
-    friend bool operator==(const Blockers&, const Blockers&) { return true; }
+  struct Newcomers {
+    std::vector<NewcomerWindows> of;
+    friend bool operator==(const Newcomers&, const Newcomers&) { return true; }
   };
-  Blockers blockers_;
+  Newcomers newcomers_;
   std::vector<Grant> pending_grants_;             // see take_grants
   LockId next_lock_id_ = 1;
   PrepareId next_prepare_id_ = 1;
