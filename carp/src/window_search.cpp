@@ -32,11 +32,9 @@ void WindowSearch::begin(const SearchInput& input) {
   const std::size_t entities = graph.topology().entity_count();
   if (entity_stamp_.size() != entities) {
     entity_stamp_.assign(entities, 0);
-    entity_first_.assign(entities, 0);
     entity_count_.assign(entities, 0);
-    kept_.assign(entities, KeptWindows{});
-    windows_.clear();
-    kept_live_ = 0;
+    entity_ids_.assign(entities, 0);
+    entity_windows_.assign(entities, nullptr);
   }
   agent_slot_ = topology::TimelineSet::AgentBits::slot(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
@@ -44,8 +42,8 @@ void WindowSearch::begin(const SearchInput& input) {
     block_stamp_.resize(blocks, 0);
     block_first_.resize(blocks, 0);
   }
-  // Only between searches: a search refers to windows by their index.
-  if (windows_.size() > 2 * kept_live_ + 4096) compact_windows();
+  own_windows_.clear();
+  window_ids_ = 0;
   states_.clear();
   open_.clear();
   sequence_ = 0;
@@ -60,58 +58,60 @@ void WindowSearch::begin(const SearchInput& input) {
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
-  const KeptWindows* kept = input.count_locks ? &kept_windows(input, entity) : nullptr;
-  if (kept == nullptr || kept->agents.may_contain(agent_slot_)) {
-    // Locks ignored, or the agent may have reservations there, which never block it.
-    entity_first_[entity] = static_cast<std::uint32_t>(windows_.size());
-    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
-                                         windows_, input.count_locks);
-    entity_count_[entity] = static_cast<std::uint32_t>(windows_.size()) - entity_first_[entity];
+  const Interval* first = nullptr;
+  std::uint32_t count = 0;
+  const topology::TimelineSet::NewcomerView newcomer =
+      input.count_locks ? input.timelines->newcomer_windows(entity)
+                        : topology::TimelineSet::NewcomerView{};
+  if (input.count_locks && !newcomer.agents.may_contain(agent_slot_)) {
+    // Served in place, without those that end by the start time. The first may start
+    // before it; the search never gets there before it, and every reader takes a window
+    // start as "free from", so that start only weakens bounds.
+    first = newcomer.windows.data();
+    count = static_cast<std::uint32_t>(newcomer.windows.size());
+    const std::uint32_t past = ending_after(first, count, input.start_time);
+    first += past;
+    count -= past;
   } else {
-    // The kept windows serve as they are, without those that end by the start time (read
-    // from an earlier time they are the same windows otherwise: a held reservation only
-    // drops the windows before it, and those end before it starts). The first may start
-    // before the start time; the search never gets there before it, and every reader
-    // takes a window start as "free from", so that start only weakens bounds.
-    const std::uint32_t past = ending_after(kept->first, kept->count, input.start_time);
-    entity_first_[entity] = kept->first + past;
-    entity_count_[entity] = kept->count - past;
+    // Locks ignored, or the agent may have reservations there, which never block it.
+    scratch_.clear();
+    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
+                                         scratch_, input.count_locks);
+    first = own_windows_.store(scratch_);
+    count = static_cast<std::uint32_t>(scratch_.size());
   }
+  entity_windows_[entity] = first;
+  entity_count_[entity] = count;
+  entity_ids_[entity] = window_ids_;
+  window_ids_ += count;
 }
 
-const WindowSearch::KeptWindows& WindowSearch::kept_windows(const SearchInput& input,
-                                                            EntityIndex entity) {
-  KeptWindows& kept = kept_[entity];
-  const std::uint64_t revision = input.timelines->windows_revision(entity);
-  if (kept.revision == revision && kept.from <= input.start_time) return kept;
-  kept_live_ -= kept.count;
-  kept.revision = revision;
-  kept.from = input.start_time;
-  kept.first = static_cast<std::uint32_t>(windows_.size());
-  kept.agents = input.timelines->append_newcomer_windows(entity, input.start_time, windows_);
-  kept.count = static_cast<std::uint32_t>(windows_.size()) - kept.first;
-  kept_live_ += kept.count;
-  return kept;
-}
-
-void WindowSearch::compact_windows() {
-  spare_windows_.clear();
-  for (KeptWindows& kept : kept_) {
-    const auto begin = windows_.begin() + kept.first;
-    kept.first = static_cast<std::uint32_t>(spare_windows_.size());
-    spare_windows_.insert(spare_windows_.end(), begin, begin + kept.count);
+const Interval* WindowSearch::WindowStore::store(const std::vector<Interval>& windows) {
+  if (windows.empty()) return nullptr;
+  if (block_ < blocks_.size() && used_ + windows.size() > blocks_[block_].size()) {
+    ++block_;  // full: on to the next block
+    used_ = 0;
   }
-  windows_.swap(spare_windows_);
+  if (block_ < blocks_.size() && windows.size() > blocks_[block_].size()) {
+    blocks_[block_].resize(windows.size());  // an unused block, too small: nothing points in
+  }
+  if (block_ == blocks_.size()) {
+    blocks_.emplace_back(std::max<std::size_t>(4096, windows.size()));
+  }
+  Interval* at = blocks_[block_].data() + used_;
+  std::copy(windows.begin(), windows.end(), at);
+  used_ += windows.size();
+  return at;
 }
 
 void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
                               EntityIndex vertex) {
   block_stamp_[key] = generation_;
   std::uint32_t count = 0;
-  const std::uint32_t first_window = windows_of(input, vertex, count);
+  windows_of(input, vertex, count);
   block_first_[key] = static_cast<std::uint32_t>(states_.size());
   for (std::uint32_t i = 0; i < count; ++i) {
-    states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, first_window + i,
+    states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, i,
                             static_cast<std::uint16_t>(layer), false});
   }
 }
@@ -147,9 +147,9 @@ TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
 
 TimeNs WindowSearch::held_after(const SearchInput& input, TimeNs at) {
   std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, input.legs.back().stop, count);
+  const Interval* first = windows_of(input, input.legs.back().stop, count);
   for (std::uint32_t g = 0; g < count; ++g) {
-    if (const TimeNs t = held_from(input, windows_[first + g], at); t != kForever) return t;
+    if (const TimeNs t = held_from(input, first[g], at); t != kForever) return t;
   }
   return kForever;
 }
@@ -160,9 +160,9 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   const DurationNs travel = input.traversal->travel(arc);
   const DurationNs clearance = input.traversal->clearance(arc);
   std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, input.graph->arc(arc).edge, count);
+  const Interval* first = windows_of(input, input.graph->arc(arc).edge, count);
   for (std::uint32_t e = 0; e < count; ++e) {
-    const Interval edge = windows_[first + e];
+    const Interval edge = first[e];
     const TimeNs onto_edge = std::max(edge.start, input.start_time);
     if (onto_edge + travel >= bound) break;
     const TimeNs z = held_after(input, onto_edge + travel);
@@ -245,45 +245,52 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
   };
   // A state is expanded again when only its cap grew: its successors' caps may grow too.
   const auto reach = [this](EntityIndex vertex, std::uint32_t window, TimeNs latest, TimeNs cap) {
-    if (late_stamp_.size() < windows_.size()) {
-      late_stamp_.resize(windows_.size(), 0);
-      late_labels_.resize(windows_.size());
+    if (late_stamp_.size() < window_ids_) {
+      late_stamp_.resize(window_ids_, 0);
+      late_labels_.resize(window_ids_);
     }
-    LateLabel& label = late_labels_[window];
-    if (late_stamp_[window] == late_generation_) {
+    const std::uint32_t id = window_id(vertex, window);
+    LateLabel& label = late_labels_[id];
+    if (late_stamp_[id] == late_generation_) {
       if (latest <= label.latest && cap <= label.cap) return;
       label = LateLabel{std::max(latest, label.latest), std::max(cap, label.cap)};
     } else {
-      late_stamp_[window] = late_generation_;
+      late_stamp_[id] = late_generation_;
       label = LateLabel{latest, cap};
     }
-    late_open_.push(LateEntry{label.latest, label.cap, window, vertex});
+    late_open_.push(LateEntry{label.latest, label.cap, window, id, vertex});
+  };
+  // Window starts before the start time read as the start time, as when the windows were
+  // read from it (the proof's margins compare with them).
+  const auto clipped = [&input](Interval w) {
+    w.start = std::max(w.start, input.start_time);
+    return w;
   };
 
   std::uint32_t goal_count = 0;
-  const std::uint32_t goal_first = windows_of(input, input.legs.back().stop, goal_count);
-  if (goal_count == 0 || windows_[goal_first + goal_count - 1].end != kForever) {
+  const Interval* goal_windows = windows_of(input, input.legs.back().stop, goal_count);
+  if (goal_count == 0 || goal_windows[goal_count - 1].end != kForever) {
     return LateProof{true, kForever};  // never held open-ended
   }
-  const std::uint32_t held = goal_first + goal_count - 1;
-  if (windows_[held].start > deadline) return LateProof{true, windows_[held].start - deadline};
-  reach(input.legs.back().stop, held, deadline, kForever);
+  const Interval held = clipped(goal_windows[goal_count - 1]);
+  if (held.start > deadline) return LateProof{true, held.start - deadline};
+  reach(input.legs.back().stop, goal_count - 1, deadline, kForever);
   std::uint32_t start_count = 0;
-  const std::uint32_t start_window = windows_of(input, input.start, start_count);
+  windows_of(input, input.start, start_count);  // the start's first window is its window 0
 
   std::size_t visited = 0;
   while (!late_open_.empty()) {
     const LateEntry top = late_open_.pop();
-    const LateLabel& label = late_labels_[top.window];
+    const LateLabel& label = late_labels_[top.id];
     if (label.latest != top.latest || label.cap != top.cap) continue;  // superseded
     if (++visited > budget) return LateProof{};
-    if (top.vertex == input.start && top.window == start_window) {
+    if (top.vertex == input.start && top.window == 0) {
       // The search's first state: ready at the start time, and never reached again.
       if (top.latest >= input.start_time) return LateProof{};
       fails_by(input.start_time, top.latest, top.cap);
       continue;
     }
-    const Interval into = windows_[top.window];
+    const Interval into = clipped(window_of(top.vertex, top.window));
     for (const ArcIndex a : graph.arcs_into(top.vertex)) {
       const EntityIndex from = graph.arc(a).from;
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
@@ -293,13 +300,13 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
       if (from_start == kUnreachable) continue;  // no route passes there, whatever the deadline
       const TimeNs earliest = input.start_time + from_start;
       std::uint32_t edge_count = 0;
-      const std::uint32_t edge_first = windows_of(input, graph.arc(a).edge, edge_count);
+      const Interval* edge_first = windows_of(input, graph.arc(a).edge, edge_count);
       // Windows ending before into.start + clearance fail the first check below: skipped.
       for (std::uint32_t i = ending_after(edge_first, edge_count, into.start + clearance - 1);
            i < edge_count; ++i) {
         // As in drive: onto the edge at y >= edge.start, arriving at z >= y + travel and
         // z >= into.start, with z + clearance <= edge.end and z <= top.latest.
-        const Interval edge = windows_[edge_first + i];
+        const Interval edge = clipped(edge_first[i]);
         const TimeNs latest_arrival = edge.end - clearance;
         if (latest_arrival < into.start || latest_arrival - travel < edge.start) continue;
         const TimeNs latest_onto_edge = std::min(top.latest, latest_arrival) - travel;
@@ -309,13 +316,13 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
           break;
         }
         std::uint32_t from_count = 0;
-        const std::uint32_t from_first = windows_of(input, from, from_count);
+        const Interval* from_first = windows_of(input, from, from_count);
         // Windows ending before edge.start + clearance fail the first check below: skipped.
         for (std::uint32_t j = ending_after(from_first, from_count, edge.start + clearance - 1);
              j < from_count; ++j) {
           // Ready at r >= window.start, onto the edge at max(r, edge.start), off the vertex
           // (tail included) before the window ends.
-          const Interval window = windows_[from_first + j];
+          const Interval window = clipped(from_first[j]);
           if (window.end - clearance < std::max(window.start, edge.start)) continue;
           if (latest_onto_edge < window.start) {  // later windows start later still
             fails_by(window.start, latest_onto_edge, cap_onto_edge);
@@ -327,7 +334,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
             fails_by(earliest, latest, cap);
             continue;
           }
-          reach(from, from_first + j, latest, cap);
+          reach(from, j, latest, cap);
         }
       }
     }
@@ -362,27 +369,27 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
   const DurationNs travel = move.travel;
   const DurationNs clearance = move.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
-  const TimeNs latest_onto_edge = windows_[current.window].end - clearance;
+  const TimeNs latest_onto_edge = window_of(current.vertex, current.window).end - clearance;
   if (current.ready > latest_onto_edge) return;
 
   std::uint32_t edge_count = 0, vertex_count = 0;
-  const std::uint32_t edge_first = windows_of(input, move.edge, edge_count);
+  const Interval* edge_first = windows_of(input, move.edge, edge_count);
   // The destination's windows are read only once the edge is known to lead somewhere:
   // reading a timeline is the dearest part of a move.
-  std::uint32_t vertex_first = kNone;
+  const Interval* vertex_first = nullptr;
   std::uint32_t block = kNone;
   DurationNs to_go = -1;  // the heuristic of a.to, looked up only if a state improves
   for (std::uint32_t i = ending_after(edge_first, edge_count, current.ready); i < edge_count; ++i) {
-    const Interval edge = windows_[edge_first + i];
+    const Interval edge = edge_first[i];
     if (edge.start > latest_onto_edge) break;
     const TimeNs onto_edge = std::max(current.ready, edge.start);
     const TimeNs earliest_arrival = onto_edge + travel;
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
-    if (vertex_first == kNone) vertex_first = windows_of(input, move.to, vertex_count);
+    if (vertex_first == nullptr) vertex_first = windows_of(input, move.to, vertex_count);
     for (std::uint32_t j = ending_after(vertex_first, vertex_count, earliest_arrival);
          j < vertex_count; ++j) {
-      const Interval window = windows_[vertex_first + j];
+      const Interval window = vertex_first[j];
       if (window.start > latest_arrival) break;
       const TimeNs arrival = std::max(earliest_arrival, window.start);
       if (arrival > input.deadline) {
@@ -400,7 +407,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
 
 bool WindowSearch::completes(const SearchInput& input, const State& state) const {
   const DurationNs hold = input.legs.back().dwell;
-  const TimeNs end = windows_[state.window].end;
+  const TimeNs end = window_of(state.vertex, state.window).end;
   return hold == kForever ? end == kForever : state.ready + hold <= end;
 }
 
@@ -408,8 +415,8 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   begin(input);
   SearchOutcome outcome;
   std::uint32_t count = 0;
-  const std::uint32_t first = windows_of(input, input.start, count);
-  if (count == 0 || windows_[first].start > input.start_time) return outcome;
+  const Interval* first = windows_of(input, input.start, count);
+  if (count == 0 || first[0].start > input.start_time) return outcome;
   outcome.start_free = true;
   // Every state's key is at least this: states that could only reach the goal before it
   // is free would otherwise all be expanded first, in order of a bound that cannot be met.
@@ -446,7 +453,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const State& current,
                           SearchOutcome& outcome) {
   const EntityIndex vertex = current.vertex;
-  const TimeNs window_end = windows_[current.window].end;
+  const TimeNs window_end = window_of(current.vertex, current.window).end;
   const Leg& leg = input.legs[current.layer];
   if (vertex == leg.stop && current.layer + 1u < input.legs.size()) {
     // Make the stop: stay for the dwell, then head for the next one from here.
@@ -456,7 +463,7 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
       outcome.horizon_cut = true;
     } else if (ready < window_end && next_estimate != kUnreachable) {
       const std::uint32_t block = states_of(input, current.layer + 1u, vertex);
-      improve(block + (current.window - entity_first_[vertex]), current.entry, ready, index,
+      improve(block + current.window, current.entry, ready, index,
               kNone, 0, next_estimate);
     }
   }

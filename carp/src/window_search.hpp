@@ -12,7 +12,8 @@
 // z + clearance <= end of e (waiting on the edge is allowed). The earliest y and z dominate
 // later ones, because the vehicle may wait inside e and w'. An arc has a single source
 // vertex, so edges need no states of their own. Memory is reused between searches: stamps
-// instead of clears, one arena for all windows and states.
+// instead of clears, one array for all states; windows are read in place where the
+// timelines keep them (a newcomer's view), or kept in blocks that never move.
 
 #include <algorithm>
 #include <cstdint>
@@ -73,7 +74,7 @@ class WindowSearch {
     std::uint32_t parent;
     std::uint32_t arc;       // the arc it came by; kNone at the start or after a stop
     std::uint32_t vertex;
-    std::uint32_t window;    // index into windows_
+    std::uint32_t window;    // which window of its vertex (see windows_of)
     std::uint16_t layer;
     bool closed;
   };
@@ -146,44 +147,55 @@ class WindowSearch {
   }
   /// The open-list entry of a state that can leave at `ready`, `estimate` to go.
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
-  /// The free windows of `entity` that end after the start time (the first may start
-  /// before it): indices [first, first + count) of windows_.
-  /// Inline: most calls find them read already.
-  std::uint32_t windows_of(const SearchInput& input, topology::EntityIndex entity,
-                           std::uint32_t& count) {
+  /// The free windows of `entity` that end after the start time, sorted (the first may
+  /// start before it): `count` of them from the pointer returned, which stays valid during
+  /// the search. Inline: most calls find them read already.
+  const topology::Interval* windows_of(const SearchInput& input, topology::EntityIndex entity,
+                                       std::uint32_t& count) {
     if (entity_stamp_[entity] != generation_) read_windows(input, entity);
     count = entity_count_[entity];
-    return entity_first_[entity];
+    return entity_windows_[entity];
   }
-  /// The offset from `first` of the first of the `count` windows at windows_[first] (sorted,
-  /// disjoint, so their ends increase) that ends after `t`; `count` if none does.
-  std::uint32_t ending_after(std::uint32_t first, std::uint32_t count, TimeNs t) const {
+  /// The index of the first of the `count` windows at `first` (sorted, disjoint, so their
+  /// ends increase) that ends after `t`; `count` if none does.
+  static std::uint32_t ending_after(const topology::Interval* first, std::uint32_t count,
+                                    TimeNs t) {
     if (count <= 8) {  // most entities have a few windows: a scan beats a binary search
       std::uint32_t i = 0;
-      while (i < count && windows_[first + i].end <= t) ++i;
+      while (i < count && first[i].end <= t) ++i;
       return i;
     }
-    const auto begin = windows_.begin() + first;
     return static_cast<std::uint32_t>(
-        std::partition_point(begin, begin + count,
+        std::partition_point(first, first + count,
                              [t](const topology::Interval& w) { return w.end <= t; }) -
-        begin);
+        first);
   }
-  /// Finds the free windows of `entity` (kept, or appended to windows_) and records where
-  /// they are.
+  /// Finds the free windows of `entity` (the timelines' newcomer view, or an exact query
+  /// kept in own_windows_) and records where they are.
   void read_windows(const SearchInput& input, topology::EntityIndex entity);
-  /// The windows of `entity` for an agent without reservations there, as kept between
-  /// searches (read again when the timelines revised them, or for an earlier start).
-  struct KeptWindows {
-    std::uint64_t revision = 0;  // TimelineSet::windows_revision when read; 0: never read
-    TimeNs from = 0;             // read from this time on
-    topology::TimelineSet::AgentBits agents;  // the agents with reservations there
-    std::uint32_t first = 0;     // index into windows_
-    std::uint32_t count = 0;
+  /// Window `window` of `vertex`, read already.
+  const topology::Interval& window_of(topology::EntityIndex vertex, std::uint32_t window) const {
+    return entity_windows_[vertex][window];
+  }
+  /// The number of window `window` of `entity` among all the windows this search read
+  /// (prove_late labels them by it).
+  std::uint32_t window_id(topology::EntityIndex entity, std::uint32_t window) const {
+    return entity_ids_[entity] + window;
+  }
+  /// Storage for the windows a search reads by exact query (where its own agent may have
+  /// reservations): blocks that never move, so that the search may hold pointers into
+  /// them while it reads more. Reused between searches.
+  class WindowStore {
+   public:
+    void clear() noexcept { block_ = 0, used_ = 0; }
+    /// Copies `windows` in and returns where they now lie.
+    const topology::Interval* store(const std::vector<topology::Interval>& windows);
+
+   private:
+    std::vector<std::vector<topology::Interval>> blocks_;  // each sized once, when made
+    std::size_t block_ = 0;  // the block being filled
+    std::size_t used_ = 0;   // of it
   };
-  const KeptWindows& kept_windows(const SearchInput& input, topology::EntityIndex entity);
-  /// Drops the windows of windows_ that no entity keeps. Only between searches.
-  void compact_windows();
   /// The index of the state for window 0 of (layer, vertex); its other windows follow.
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex) {
@@ -207,16 +219,16 @@ class WindowSearch {
               SearchOutcome& outcome);
 
   std::uint32_t generation_ = 0;
-  std::vector<std::uint32_t> entity_stamp_, entity_first_, entity_count_;
+  // Per entity, valid where stamped with the search's generation: where its windows are,
+  // how many, and the id of the first (see window_id).
+  std::vector<std::uint32_t> entity_stamp_, entity_count_, entity_ids_;
+  std::vector<const topology::Interval*> entity_windows_;
+  std::uint32_t window_ids_ = 0;  // windows read by this search
   std::vector<std::uint32_t> block_stamp_, block_first_;
-  // Every window the searches read, in one arena that outlives a search: the free windows
-  // kept per entity between searches (kept_), and the windows each search read for its
-  // own agent. A plan reads thousands of timelines, and most have not changed since the
-  // plan before: reading one costs a cache miss per few reservations, and kept windows
-  // serve in place.
-  std::vector<topology::Interval> windows_, spare_windows_;
-  std::vector<KeptWindows> kept_;
-  std::size_t kept_live_ = 0;     // windows of windows_ that an entity keeps
+  // Most windows are served in place from the timelines' newcomer views (kept by the
+  // TimelineSet between changes); those of an exact query live here.
+  WindowStore own_windows_;
+  std::vector<topology::Interval> scratch_;  // an exact query's answer, before it is stored
   std::uint8_t agent_slot_ = 0;   // TimelineSet::AgentBits::slot of the search's agent
   std::vector<State> states_;
   MinHeap<OpenEntry> open_;
@@ -226,18 +238,19 @@ class WindowSearch {
     TimeNs latest = 0;
     TimeNs cap = 0;
   };
-  /// An open state of that search: `window` (an index into windows_) of `vertex`. The
+  /// An open state of that search: window `window` of `vertex` (its id is `id`). The
   /// latest first.
   struct LateEntry {
     TimeNs latest;
     TimeNs cap;
     std::uint32_t window;
+    std::uint32_t id;
     topology::EntityIndex vertex;
     bool operator>(const LateEntry& o) const { return latest < o.latest; }
   };
   MinHeap<LateEntry> late_open_;
-  std::vector<LateLabel> late_labels_;     // per window index, valid where stamped
-  std::vector<std::uint32_t> late_stamp_;  // per window index
+  std::vector<LateLabel> late_labels_;     // per window id, valid where stamped
+  std::vector<std::uint32_t> late_stamp_;  // per window id
   std::uint32_t late_generation_ = 0;
   ReachTable from_start_;                    // see distance_from_start
   std::uint32_t from_start_generation_ = 0;  // generation_ of the search it was set up for

@@ -95,19 +95,10 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
         });
 }
 
-TimelineSet::AgentBits TimelineSet::append_newcomer_windows(EntityIndex entity, TimeNs from,
-                                                           std::vector<Interval>& out) const {
-  if (!owns(entity)) return AgentBits{};
-  // The windows from the beginning of time, clipped: a sweep from `from` finds the same
-  // ones, except those ending by then (a holder starting by then only dropped windows that
-  // end before it, and a lock cut commutes with the clip).
+TimelineSet::NewcomerView TimelineSet::newcomer_windows(EntityIndex entity) const {
+  if (!owns(entity)) return NewcomerView{};
   const NewcomerWindows& newcomer = newcomers_.of[entity];
-  const auto first = std::partition_point(newcomer.windows.begin(), newcomer.windows.end(),
-                                          [from](const Interval& w) { return w.end <= from; });
-  for (auto w = first; w != newcomer.windows.end(); ++w) {
-    out.push_back(Interval{std::max(w->start, from), w->end});
-  }
-  return newcomer.agents;
+  return NewcomerView{newcomer.windows, newcomer.agents};
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

@@ -29,6 +29,7 @@
 #include <cstring>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -267,12 +268,19 @@ class TimelineSet {
    private:
     std::array<std::uint64_t, 4> words_{};
   };
-  /// The windows append_free_windows(entity, agent, from, kForever, out) appends for an
-  /// agent with no reservation on the entity (every reservation there blocks), appended to
-  /// `out`. \return the agents with a reservation there: for an agent not in it, these are
+  /// The windows of an agent with no reservation on an entity (every reservation there
+  /// blocks) from the beginning of time: append_free_windows(entity, agent, from, kForever,
+  /// out) appends those that end after `from`, the first starting at `from` at the
+  /// earliest. And the agents with a reservation there: for an agent not in it, these are
   /// its windows.
-  AgentBits append_newcomer_windows(EntityIndex entity, TimeNs from,
-                                    std::vector<Interval>& out) const;
+  struct NewcomerView {
+    std::span<const Interval> windows;
+    AgentBits agents;
+  };
+  /// \return the view of `entity`, kept by the set (recomputed whenever the entity's
+  ///         windows revision moves): valid until the set changes. Empty for an entity not
+  ///         owned.
+  NewcomerView newcomer_windows(EntityIndex entity) const;
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
   /// allocation of a reservation's origin). Equal revisions of an entity, on this set or
@@ -453,7 +461,7 @@ class TimelineSet {
   };
   Revisions revisions_;
   // Per entity, the answer of a newcomer's free-window query from the beginning of time
-  // (append_newcomer_windows clips it), recomputed with the windows revision (every change
+  // (newcomer_windows), recomputed with the windows revision (every change
   // of what free windows read moves it). Planners ask it after every change of the
   // timelines they read, and sweeping the reservations then was memory-bound (bench plan:
   // a fifth of the planner's time, most of it cache misses on reservations and holders);
