@@ -60,9 +60,8 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   entity_stamp_[entity] = generation_;
   const Interval* first = nullptr;
   std::uint32_t count = 0;
-  const topology::TimelineSet::NewcomerView newcomer =
-      input.count_locks ? input.timelines->newcomer_windows(entity)
-                        : topology::TimelineSet::NewcomerView{};
+  const topology::TimelineSet::NewcomerWindows& newcomer =
+      input.timelines->newcomer_windows(entity);
   if (input.count_locks && !newcomer.agents.may_contain(agent_slot_)) {
     // Served in place, without those that end by the start time. The first may start
     // before it; the search never gets there before it, and every reader takes a window

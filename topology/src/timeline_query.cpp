@@ -95,11 +95,6 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
         });
 }
 
-TimelineSet::NewcomerView TimelineSet::newcomer_windows(EntityIndex entity) const {
-  if (!owns(entity)) return NewcomerView{};
-  const NewcomerWindows& newcomer = newcomers_.of[entity];
-  return NewcomerView{newcomer.windows, newcomer.agents};
-}
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {
   return entity < revisions_.of.size() ? revisions_.of[entity] : 0;

@@ -273,14 +273,17 @@ class TimelineSet {
   /// out) appends those that end after `from`, the first starting at `from` at the
   /// earliest. And the agents with a reservation there: for an agent not in it, these are
   /// its windows.
-  struct NewcomerView {
-    std::span<const Interval> windows;
+  struct NewcomerWindows {
+    std::vector<Interval> windows;
     AgentBits agents;
   };
-  /// \return the view of `entity`, kept by the set (recomputed whenever the entity's
-  ///         windows revision moves): valid until the set changes. Empty for an entity not
-  ///         owned.
-  NewcomerView newcomer_windows(EntityIndex entity) const;
+  /// \return those of `entity`, kept by the set (recomputed whenever the entity's windows
+  ///         revision moves): valid until the set changes. Empty for an entity not owned.
+  ///         Inline: a planner asks for every entity it reads.
+  const NewcomerWindows& newcomer_windows(EntityIndex entity) const noexcept {
+    static const NewcomerWindows kNone;  // entities not owned have no windows there either
+    return entity < newcomers_.of.size() ? newcomers_.of[entity] : kNone;
+  }
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
   /// allocation of a reservation's origin). Equal revisions of an entity, on this set or
@@ -460,17 +463,12 @@ class TimelineSet {
     friend bool operator==(const Revisions&, const Revisions&) { return true; }
   };
   Revisions revisions_;
-  // Per entity, the answer of a newcomer's free-window query from the beginning of time
-  // (newcomer_windows), recomputed with the windows revision (every change
-  // of what free windows read moves it). Planners ask it after every change of the
-  // timelines they read, and sweeping the reservations then was memory-bound (bench plan:
-  // a fifth of the planner's time, most of it cache misses on reservations and holders);
-  // the revision moves once per change, in the same pass over the timeline that changed.
-  // Derived: equal sets may differ in it.
-  struct NewcomerWindows {
-    std::vector<Interval> windows;
-    AgentBits agents;  // the agents with a reservation there
-  };
+  // Per entity, see newcomer_windows: recomputed whenever its windows revision moves
+  // (every change of what free windows read moves it), in the pass that moves it. Planners
+  // read them for every entity they touch, and sweeping the reservations then was
+  // memory-bound (bench plan: a fifth of the planner's time, most of it cache misses on
+  // reservations and holders). Empty for entities not owned. Derived: equal sets may
+  // differ in it.
   struct Newcomers {
     std::vector<NewcomerWindows> of;
     friend bool operator==(const Newcomers&, const Newcomers&) { return true; }
