@@ -4,10 +4,10 @@
 // in timeline_query.cpp.
 
 #include <algorithm>
-#include <limits>
 #include <atomic>
 #include <cassert>
 #include <functional>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <utility>

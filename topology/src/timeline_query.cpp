@@ -95,7 +95,6 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
         });
 }
 
-
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {
   return entity < revisions_.of.size() ? revisions_.of[entity] : 0;
 }
