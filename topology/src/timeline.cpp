@@ -50,11 +50,12 @@ void TimelineSet::Impl::sort_reservations(Timeline& timeline) {
   std::sort(timeline.reservations.begin(), timeline.reservations.end(), timeline_order);
 }
 
-void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touched) {
+void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touched,
+                                      Windows windows) {
   const std::uint64_t revision = next_revision();
   for (EntityIndex entity : touched) {
     ++set.timelines_[entity].version;
-    revise(set, entity, revision);
+    if (windows == Windows::changed) revise(set, entity, revision);
   }
 }
 

@@ -18,9 +18,13 @@ struct TimelineSet::Impl {
   /// Timeline order (see Timeline::reservations).
   static bool timeline_order(const Reservation& a, const Reservation& b);
   static void sort_reservations(Timeline& timeline);
-  /// Increments the version of every touched entity and revises its free windows (a
-  /// change of reservations changes only the windows of the timelines it touches).
-  static void bump_versions(TimelineSet& set, const TouchedSet& touched);
+  /// Whether a change of timelines changed what their free windows read.
+  enum class Windows { changed, unchanged };
+  /// Increments the version of every touched entity and, unless `windows` is unchanged,
+  /// revises its free windows (a change of reservations changes only the windows of the
+  /// timelines it touches).
+  static void bump_versions(TimelineSet& set, const TouchedSet& touched,
+                            Windows windows = Windows::changed);
   /// A revision number never used before in this process.
   static std::uint64_t next_revision();
   /// Revises the free windows of `entity` and of the members of its conflict set, for a

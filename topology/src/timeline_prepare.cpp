@@ -212,7 +212,9 @@ Status TimelineSet::commit(PrepareId id) {
   prepared_.erase(found);
   // The agent's own new reservation may come before everyone else's where it waits.
   Impl::keep_grants(*this, Impl::grant_waiting(*this, TouchedSet(touched), touched));
-  Impl::bump_versions(*this, touched);
+  // A prepared reservation blocks others as a committed one does, so the free windows stay
+  // (a grant above revised those it changed): no entity's windows are recomputed.
+  Impl::bump_versions(*this, touched, Impl::Windows::unchanged);
   return {};
 }
 
