@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -87,8 +88,14 @@ std::string read_file(const std::string& path) {
 }
 
 std::string binary_path(const std::string& name) {
-  const char* dir = std::getenv("DROVER_BINARY_DIR");
-  return std::string(dir != nullptr ? dir : ".") + "/bin/" + name;
+  if (const char* dir = std::getenv("DROVER_BINARY_DIR"); dir != nullptr) {
+    return std::string(dir) + "/bin/" + name;
+  }
+  // Run by hand, not by ctest: the executables are beside the test's own (build/bin).
+  if (const auto self = launcher::current_executable(); self) {
+    return (std::filesystem::path(*self).parent_path() / name).string();
+  }
+  return "./bin/" + name;
 }
 
 }  // namespace drover::test

@@ -46,7 +46,8 @@ class ChildProcess {
   int pidfd_ = -1;
 };
 
-/// DROVER_BINARY_DIR/bin/<name>: where the build puts executables.
+/// DROVER_BINARY_DIR/bin/<name>: where the build puts executables (ctest sets the variable;
+/// without it, the directory of the running test executable, which is that same bin/).
 std::string binary_path(const std::string& name);
 
 /// The whole content of a file ("" when it cannot be read).

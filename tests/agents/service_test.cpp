@@ -223,7 +223,7 @@ TEST_F(ServiceTest, RequestsGoToTheNamedServerOrToEachServerInTurn) {
 
   auto unknown = client->call(ping("to nobody"), 300ms, "echo-c");
   ASSERT_FALSE(unknown.has_value());
-  EXPECT_NE(unknown.error().message.find("server 'echo-c' for service"), std::string::npos)
+  EXPECT_NE(unknown.error().message.find("no server 'echo-c' for service"), std::string::npos)
       << unknown.error().message;
 }
 

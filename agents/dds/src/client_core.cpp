@@ -94,7 +94,7 @@ Result<ServerRef> ClientCore::wait_for_server(const std::string& responder, Dead
   std::optional<ServerRef> server;
   state_changed_.wait_until(lock, deadline, [&] { return (server = pick_server(responder)).has_value(); });
   if (server) return std::move(*server);
-  const std::string who = responder.empty() ? "no server" : "server '" + responder + "'";
+  const std::string who = responder.empty() ? "no server" : "no server '" + responder + "'";
   return fail(ErrorCode::timeout, who + " for service '" + topics_.name + "' matched within " +
                                       ms_text(timeout) + " (is it running on domain " +
                                       std::to_string(participant_.domain_id()) + "?)");
