@@ -149,6 +149,9 @@ struct Planner::Impl {
     if (options.horizon <= 0) return invalid("the planner's horizon must be > 0");
     if (options.floor_proof_after == 0) return invalid("the planner's floor_proof_after must be >= 1");
     if (options.floor_proof_budget == 0) return invalid("the planner's floor_proof_budget must be >= 1");
+    if (options.quick_proof_after > 0 && options.quick_proof_budget == 0) {
+      return invalid("the planner's quick_proof_budget must be >= 1 when quick_proof_after is set");
+    }
     if (request.agent.empty()) return invalid("the agent id is empty");
     if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
     if (timelines.entity_count() != topology().entity_count()) {
@@ -376,6 +379,8 @@ struct Planner::Impl {
     input.start_time = request.start_time;
     input.legs = legs;
     input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
+    input.quick_proof_after = options.quick_proof_after;
+    input.quick_proof_budget = options.quick_proof_budget;
     input.floor_proof_after = options.floor_proof_after;
     input.floor_proof_budget = options.floor_proof_budget;
     const SearchOutcome outcome = search.run(input);

@@ -10,13 +10,14 @@ using topology::Interval;
 namespace {
 
 /// How many times a search raises the arrival floor in a row (each by one proof). Once a
-/// search has expanded input.floor_proof_after states keyed by the floor, it tries to prove
-/// the floor too early (prove_late) with a budget of input.floor_proof_budget backward
-/// states (by default as many); if that fails, it tries again at four times as many with
-/// four times the budget, so the proofs cost at most about half the expansions. A floor
-/// one step below the arrival can cost tens of thousands of expansions (warehouse N = 400:
-/// 12 000 for an agent that needs 60 with the exact floor), while most searches expand only
-/// a few hundred states and never try.
+/// search has expanded input.quick_proof_after states keyed by the floor, it tries a quick
+/// proof that the floor is too early (prove_late with input.quick_proof_budget backward
+/// states and no forward table), once per floor. After input.floor_proof_after, it tries a
+/// full proof with a budget of input.floor_proof_budget; if that fails, it tries again at
+/// four times as many with four times the budget, so the proofs cost at most about half the
+/// expansions. A floor one step below the arrival can cost tens of thousands of expansions
+/// (warehouse N = 400: 12 000 for an agent that needs 60 with the exact floor), while most
+/// searches expand only a few hundred states and never try a full proof.
 constexpr int kLateProofRounds = 8;
 
 }  // namespace
@@ -170,11 +171,13 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   return kForever;
 }
 
-bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
+bool WindowSearch::raise_arrival_floor(const SearchInput& input, ProofKind kind) {
   if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return true;
   const TimeNs floor = arrival_floor_;
+  proof_kind_ = kind;
+  const std::size_t budget = kind == ProofKind::quick ? input.quick_proof_budget : proof_budget_;
   for (int round = 0; round < kLateProofRounds; ++round) {
-    const LateProof proof = prove_late(input, arrival_floor_, proof_budget_);
+    const LateProof proof = prove_late(input, arrival_floor_, budget);
     ++floor_proofs_;
     if (!proof.proven) break;
     ++floor_raises_;
@@ -185,6 +188,7 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
     arrival_floor_ += proof.margin;
   }
   if (arrival_floor_ == floor) {
+    if (kind == ProofKind::quick) return true;  // tried once per floor
     proof_budget_ *= 4;
     next_proof_at_ *= 4;
     return true;
@@ -204,9 +208,9 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input) {
 // - s_n: latest = deadline >= r_n - d, cap = kForever.
 // - Step from s_(i+1) over arc a, edge window e, window W of s_i, onto the edge at y: the
 //   route has max(r_i, e.start) <= y <= min(r_(i+1), e.end - clearance) - travel,
-//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + the reservation-free
-//   travel time from the start to its vertex (distance_from_start, finite: the route got
-//   there). So the checks that do not depend on the deadline (`continue` without fails_by)
+//   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + a lower bound of the
+//   reservation-free travel time from the start to its vertex (travel_from_start, finite:
+//   the route got there, and goes on to the last stop). So the checks that do not depend on the deadline (`continue` without fails_by)
 //   pass; the label side of the others is >= y - d (latest) and >= y (cap): the edge
 //   check's top.latest - travel, and latest_onto_edge, are >= y - d; the window and
 //   travel-time checks' label >= r_i - d.
@@ -295,7 +299,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
       const DurationNs travel = traversal.travel(a);
       const DurationNs clearance = traversal.clearance(a);
-      const DurationNs from_start = distance_from_start(input, from);
+      const DurationNs from_start = travel_from_start(input, from);
       if (from_start == kUnreachable) continue;  // no route passes there, whatever the deadline
       const TimeNs earliest = input.start_time + from_start;
       std::uint32_t edge_count = 0;
@@ -429,8 +433,15 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
     const OpenEntry top = open_.pop();
     State& popped = states_[top.state];
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
-    if (top.f == arrival_floor_ && ++floor_pops_ == next_proof_at_) {
-      if (!raise_arrival_floor(input)) return outcome;
+    if (top.f == arrival_floor_) {
+      ++floor_pops_;
+      if (floor_pops_ == input.quick_proof_after &&
+          !raise_arrival_floor(input, ProofKind::quick)) {
+        return outcome;
+      }
+      if (floor_pops_ == next_proof_at_ && !raise_arrival_floor(input, ProofKind::full)) {
+        return outcome;
+      }
       if (top.f < arrival_floor_) {  // the key rose: back to the open list
         open_.push(open_entry(top.ready, top.h, top.state));
         continue;

@@ -46,6 +46,8 @@ struct SearchInput {
   std::span<const Leg> legs;
   TimeNs deadline = 0;         ///< states that could only leave later are dropped
   bool count_locks = true;
+  std::size_t quick_proof_after = 64;    ///< PlannerOptions::quick_proof_after
+  std::size_t quick_proof_budget = 16;   ///< PlannerOptions::quick_proof_budget
   std::size_t floor_proof_after = 512;   ///< PlannerOptions::floor_proof_after
   std::size_t floor_proof_budget = 128;  ///< PlannerOptions::floor_proof_budget
 };
@@ -115,12 +117,15 @@ class WindowSearch {
   /// The earliest arrival at the last stop along `arc` that its edge's windows allow, if
   /// before `bound`; kForever otherwise.
   TimeNs arrival_over(const SearchInput& input, ArcIndex arc, TimeNs bound);
+  /// The two kinds of floor proof: quick ones bound how early a route can be at a vertex
+  /// by the heuristic alone and visit few states; full ones use the exact forward table.
+  enum class ProofKind { quick, full };
   /// Raises arrival_floor_ while prove_late proves that no route arrives by it, and re-keys
   /// the open list. Only for one open-ended stop. Called once a search has expanded many
   /// states keyed by the floor: all that could arrive by the floor share it as key, and with
   /// a floor below the arrival every one of them must be expanded.
   /// \return false when no route can ever arrive (a certificate of failure).
-  bool raise_arrival_floor(const SearchInput& input);
+  bool raise_arrival_floor(const SearchInput& input, ProofKind kind);
   /// What a backward search from the last stop found about arrivals by a deadline.
   struct LateProof {
     bool proven = false;     ///< no route arrives by the deadline
@@ -128,17 +133,28 @@ class WindowSearch {
   };
   /// A backward search over (vertex, free window) states from the open-ended window of the
   /// last stop, labelled with the latest time the vehicle may be ready there and still arrive
-  /// by `deadline`; states the vehicle cannot reach in time (distance_from_start) are
+  /// by `deadline`; states the vehicle cannot reach in time (travel_from_start) are
   /// dropped. If it ends without reaching the start state, no route arrives by
   /// the deadline. Each check it failed compares a time that grows at most as fast as the
   /// deadline with a fixed one; the smallest gap is a margin by which the deadline can grow
   /// with every check still failing, so with no route arriving. Gives up (not proven) after
   /// `budget` states.
   LateProof prove_late(const SearchInput& input, TimeNs deadline, std::size_t budget);
-  /// The reservation-free travel time from the start to `vertex`, kUnreachable if none: the
-  /// earliest a route can be there after the start time. Found on demand, in a table set up
-  /// by the first call of each search (only searches that try a proof pay for it).
-  DurationNs distance_from_start(const SearchInput& input, topology::EntityIndex vertex) {
+  /// A lower bound of the reservation-free travel time from the start to `vertex`,
+  /// kUnreachable if no route passes there: the earliest a route can be there after the
+  /// start time. In a full proof the exact time, from a table set up by the first call of
+  /// each search (only searches that try a full proof pay for it, about one heuristic
+  /// search); in a quick proof the heuristic's triangle inequality, h(start) - h(vertex)
+  /// (a route through a vertex that cannot reach the last stop does not exist either).
+  DurationNs travel_from_start(const SearchInput& input, topology::EntityIndex vertex) {
+    if (proof_kind_ == ProofKind::quick) {
+      const Leg& last = input.legs.back();
+      const DurationNs to_stop = last.table->distance(*input.graph, *input.traversal, vertex);
+      if (to_stop == kUnreachable) return kUnreachable;
+      const DurationNs from_start =
+          last.table->distance(*input.graph, *input.traversal, input.start);
+      return std::max<DurationNs>(0, from_start - to_stop);
+    }
     if (from_start_generation_ != generation_) {
       from_start_.reset(*input.graph, input.start);
       from_start_generation_ = generation_;
@@ -252,7 +268,8 @@ class WindowSearch {
   std::vector<LateLabel> late_labels_;     // per window id, valid where stamped
   std::vector<std::uint32_t> late_stamp_;  // per window id
   std::uint32_t late_generation_ = 0;
-  ReachTable from_start_;                    // see distance_from_start
+  ProofKind proof_kind_ = ProofKind::full;   // of the proof running (travel_from_start)
+  ReachTable from_start_;                    // see travel_from_start
   std::uint32_t from_start_generation_ = 0;  // generation_ of the search it was set up for
   std::uint32_t sequence_ = 0;
   TimeNs arrival_floor_ = 0;  // no arrival at the last stop can be earlier (see arrival_floor)

@@ -245,18 +245,21 @@ PlanRequest random_request(const World& w, std::mt19937& rng, bool open_ended_on
 /// Plans `trials` random requests on random small grids with random traffic and compares
 /// each with the brute force: the arrival, and the arrival floor the search ended with
 /// (which must never pass the earliest arrival, whatever the search's luck in finding it).
-/// `open_ended_only`: requests with one open-ended stop, and every fourth trial with a
-/// small floor_proof_budget (1 to 32 states), so that proofs also give up and try again.
+/// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
+/// proof budgets (1 to 32 states), so that proofs also give up and try again.
 /// `raised`: in how many trials a backward proof raised the floor.
 void check_against_brute_force(PlannerOptions options, int trials, bool open_ended_only = false,
                                int* raised = nullptr) {
   const std::size_t budget = options.floor_proof_budget;
+  const std::size_t quick_budget = options.quick_proof_budget;
   std::mt19937 rng(20240611);
   int found = 0, refused = 0;
   if (raised != nullptr) *raised = 0;
   for (int trial = 0; trial < trials; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial));
-    options.floor_proof_budget = open_ended_only && trial % 4 == 3 ? 1 + trial / 4 % 32 : budget;
+    const bool small = open_ended_only && trial % 4 == 3;
+    options.floor_proof_budget = small ? 1 + trial / 4 % 32 : budget;
+    options.quick_proof_budget = small ? 1 + trial / 4 % 32 : quick_budget;
     World w(random_grid(rng), options);
     const std::vector<Blocker> blockers = random_traffic(w, rng);
     const PlanRequest request = random_request(w, rng, open_ended_only);
@@ -305,10 +308,25 @@ TEST(PlannerRandom, RoutesAreValidCollisionFreeAndArriveAtTheEarliestPossibleTim
 // claims too much shows. Checked: the final floor and the arrival against the brute force.
 TEST(PlannerRandom, RaisingTheArrivalFloorByProofsKeepsTheEarliestArrival) {
   int raised = 0;
-  check_against_brute_force(
-      PlannerOptions{.horizon = sec(1000), .floor_proof_after = 1, .floor_proof_budget = 1 << 20},
-      1200, true, &raised);
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .quick_proof_after = 0,
+                                           .floor_proof_after = 1,
+                                           .floor_proof_budget = 1 << 20},
+                            1200, true, &raised);
   EXPECT_GT(raised, 150) << raised;  // the proofs must have been put to work
+}
+
+// The same for quick proofs alone (how early a route reaches a vertex bounded by the
+// heuristic's triangle inequality, not by the forward table): one after every floor-keyed
+// expansion, as each raise starts the count again.
+TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) {
+  int raised = 0;
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .quick_proof_after = 1,
+                                           .quick_proof_budget = 1 << 20,
+                                           .floor_proof_after = std::size_t{1} << 40},
+                            1200, true, &raised);
+  EXPECT_GT(raised, 150) << raised;
 }
 
 TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {

@@ -17,10 +17,17 @@ struct PlannerOptions {
   /// How many heuristic tables (one per goal and vehicle class) are kept between calls.
   std::size_t heuristic_tables = 64;
   /// After expanding this many states keyed by the arrival floor (the earliest the last
-  /// stop can be entered and held), a search tries to prove that no route arrives that
-  /// early and raises the floor (docs/carp.md); four times as many before each further try.
-  /// Any value >= 1 gives the same arrivals; 512 paid off best on the benchmark's maps
-  /// (128, 256, 1024 tried; docs/benchmarks.md).
+  /// stop can be entered and held), a search tries a quick proof that no route arrives that
+  /// early, to raise the floor (docs/carp.md): at most quick_proof_budget backward states,
+  /// with how early a route can reach a vertex bounded by the heuristic alone, so that
+  /// trying costs almost nothing. Once per floor; 0: never. Any value gives the same
+  /// arrivals; 64 and 16 paid off best on the benchmark's maps (docs/benchmarks.md).
+  std::size_t quick_proof_after = 64;
+  std::size_t quick_proof_budget = 16;
+  /// After expanding this many states keyed by the arrival floor, a search tries a full
+  /// proof (with the exact earliest times from the start, a forward table); four times as
+  /// many before each further try. Any value >= 1 gives the same arrivals; 512 paid off best
+  /// on the benchmark's maps (128, 256, 1024 tried; docs/benchmarks.md).
   std::size_t floor_proof_after = 512;
   /// How many backward states such a proof may visit before it gives up; four times as many
   /// at each further try. Any value >= 1 gives the same arrivals; 128 paid off best (64,
