@@ -210,10 +210,10 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input, ProofKind kind)
 //   route has max(r_i, e.start) <= y <= min(r_(i+1), e.end - clearance) - travel,
 //   y <= W.end - clearance, r_i >= W.start and r_i >= start_time + a lower bound of the
 //   reservation-free travel time from the start to its vertex (travel_from_start, finite:
-//   the route got there, and goes on to the last stop). So the checks that do not depend on the deadline (`continue` without fails_by)
-//   pass; the label side of the others is >= y - d (latest) and >= y (cap): the edge
-//   check's top.latest - travel, and latest_onto_edge, are >= y - d; the window and
-//   travel-time checks' label >= r_i - d.
+//   the route got there, and goes on to the last stop). So the checks that do not depend
+//   on the deadline (`continue` without fails_by) pass; the label side of the others is
+//   >= y - d (latest) and >= y (cap): the edge check's top.latest - travel, and
+//   latest_onto_edge, are >= y - d; the window and travel-time checks' label >= r_i - d.
 //   Had one failed, it would have recorded a gap <= d < margin (its cap reaches the fixed
 //   time, so it counts). The breaks skip only windows that start later (larger gaps). So
 //   s_i is reached with latest >= min(y - d, W.end - clearance) >= r_i - d and cap >= r_i.

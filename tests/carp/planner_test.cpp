@@ -348,6 +348,28 @@ TEST(Planner, RejectsInvalidRequests) {
   EXPECT_EQ(planned.error().reason, PlanFailure::invalid_request);
 }
 
+// Bad options are the caller's mistake too: every plan call refuses them, naming the option.
+TEST(Planner, RejectsInvalidOptions) {
+  const std::vector<std::pair<PlannerOptions, std::string>> cases = {
+      {PlannerOptions{.horizon = 0}, "horizon"},
+      {PlannerOptions{.floor_proof_after = 0}, "floor_proof_after"},
+      {PlannerOptions{.floor_proof_budget = 0}, "floor_proof_budget"},
+      {PlannerOptions{.quick_proof_after = 8, .quick_proof_budget = 0}, "quick_proof_budget"},
+  };
+  for (const auto& [options, named] : cases) {
+    SCOPED_TRACE(named);
+    World w(GridBuilder().corridor(3).build(), options);
+    const auto planned = w.planner.plan(w.timelines, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+    ASSERT_FALSE(planned.has_value());
+    EXPECT_EQ(planned.error().reason, PlanFailure::invalid_request);
+    EXPECT_NE(planned.error().message.find(named), std::string::npos) << planned.error().message;
+  }
+  // No quick proofs at all needs no budget for them.
+  World w(GridBuilder().corridor(3).build(),
+          PlannerOptions{.quick_proof_after = 0, .quick_proof_budget = 0});
+  EXPECT_TRUE(w.planner.plan(w.timelines, request_to(w, "a", "0,0", {open_stop(w, "2,0")})));
+}
+
 TEST(Planner, ATestRouteReservesNothing) {
   World w(GridBuilder().corridor(4).build());
   w.occupy("b", "2,0", sec(0), sec(3));
