@@ -11,8 +11,10 @@ void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex roo
   root_ = root;
   label_.assign(graph.vertex_count(), kUnreachable);
   open_.clear();
+  fifo_.clear();
+  fifo_head_ = 0;
   label_[root] = 0;
-  open_.push(0, root);
+  queued_root_ = false;  // the first resume queues it, knowing the traversal
 }
 
 template <Direction kDirection>
@@ -20,17 +22,30 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
                                              const Traversal& traversal, EntityIndex vertex) {
   // Keys are distances in units of the shortest arc's travel time, rounded down (Dinitz):
   // whatever the order among equal keys, a vertex's distance is final when it is popped,
-  // since every arc into it comes from a vertex with a smaller key, popped before. On
-  // uniform grids the keys are small integers, and the radix heap hardly moves an item.
+  // since every arc into it comes from a vertex with a smaller key, popped before. When
+  // every arc takes the same time, a first-in first-out queue pops in order of distance
+  // (breadth-first search): no keys, no division, each vertex queued once.
+  const bool breadth_first = traversal.uniform();
   const DurationNs unit = traversal.min_travel();
+  const auto queue = [&](EntityIndex next, DurationNs through) {
+    if (breadth_first) {
+      fifo_.push_back(next);
+    } else {
+      open_.push(static_cast<std::uint64_t>(through / unit), next);
+    }
+  };
   const auto relax = [&](EntityIndex next, DurationNs through) {
     if (through >= label_[next]) return;  // closed, or no better
     label_[next] = through;
-    open_.push(static_cast<std::uint64_t>(through / unit), next);
+    queue(next, through);
   };
+  if (!queued_root_) {
+    queued_root_ = true;
+    queue(root_, 0);
+  }
   const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
-  while (!open_.empty()) {
-    const EntityIndex top = open_.pop().value;
+  while (breadth_first ? fifo_head_ < fifo_.size() : !open_.empty()) {
+    const EntityIndex top = breadth_first ? fifo_[fifo_head_++] : open_.pop().value;
     const DurationNs distance = label_[top];
     if (distance < 0) continue;  // stale: popped before
     label_[top] = ~distance;

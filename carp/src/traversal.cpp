@@ -21,6 +21,7 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   usable_arc_.resize(arcs);
   double ns_per_metre = std::numeric_limits<double>::infinity();
   DurationNs shortest = kForever;
+  DurationNs longest = 0;
   for (ArcIndex a = 0; a < arcs; ++a) {
     const Arc& arc = graph.arc(a);
     const double speed = std::min(vehicle.max_speed, arc.speed_limit);
@@ -29,7 +30,10 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
                                                 std::ceil(vehicle.length / speed * 1e9)));
     usable_arc_[a] = usable_vertex_[arc.to] &&
                      !restriction_violation(topology.edge(arc.edge).restrictions, vehicle);
-    if (usable_arc_[a]) shortest = std::min(shortest, travel_[a]);
+    if (usable_arc_[a]) {
+      shortest = std::min(shortest, travel_[a]);
+      longest = std::max(longest, travel_[a]);
+    }
     const double straight = graph.straight_distance(arc.from, arc.to);
     if (straight > 0) {
       ns_per_metre = std::min(ns_per_metre, static_cast<double>(travel_[a]) / straight);
@@ -39,6 +43,7 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   // the bound inconsistent by a nanosecond.
   ns_per_metre_ = std::isfinite(ns_per_metre) ? ns_per_metre * (1 - 1e-9) : 0;
   min_travel_ = shortest == kForever ? 1 : shortest;
+  uniform_ = shortest == kForever || shortest == longest;
 }
 
 void Traversal::find_components(const RoutingGraph& graph) const {

@@ -31,6 +31,9 @@ class Traversal {
   DurationNs clearance(ArcIndex arc) const { return clearance_[arc]; }
   /// The shortest travel() of a usable arc (1 ns when none is usable).
   DurationNs min_travel() const { return min_travel_; }
+  /// Every usable arc takes the same time (a grid with one speed): shortest paths by time
+  /// are shortest by arc count.
+  bool uniform() const { return uniform_; }
   bool usable_vertex(topology::EntityIndex vertex) const { return usable_vertex_[vertex] != 0; }
   /// The vehicle may drive the arc: its edge and its destination vertex allow it.
   bool usable_arc(ArcIndex arc) const { return usable_arc_[arc] != 0; }
@@ -106,6 +109,7 @@ class Traversal {
   mutable Adjacency adjacency_;  // empty until adjacency() needs it (a cache, as component_)
   double ns_per_metre_ = 0;
   DurationNs min_travel_ = 1;
+  bool uniform_ = true;
 };
 
 /// The traversals of the vehicle classes seen lately (least recently used dropped first).
