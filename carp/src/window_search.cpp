@@ -174,10 +174,9 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
 bool WindowSearch::raise_arrival_floor(const SearchInput& input, ProofKind kind) {
   if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return true;
   const TimeNs floor = arrival_floor_;
-  proof_kind_ = kind;
   const std::size_t budget = kind == ProofKind::quick ? input.quick_proof_budget : proof_budget_;
   for (int round = 0; round < kLateProofRounds; ++round) {
-    const LateProof proof = prove_late(input, arrival_floor_, budget);
+    const LateProof proof = prove_late(input, kind, arrival_floor_, budget);
     ++floor_proofs_;
     if (!proof.proven) break;
     ++floor_raises_;
@@ -230,8 +229,8 @@ bool WindowSearch::raise_arrival_floor(const SearchInput& input, ProofKind kind)
 // max(ready + h, floor) stay admissible, improve() reopens closed states, and the first
 // completed state popped is the earliest arrival. planner_random_test checks the final
 // floor itself against the brute force.
-WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeNs deadline,
-                                                 std::size_t budget) {
+WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, ProofKind kind,
+                                                 TimeNs deadline, std::size_t budget) {
   const RoutingGraph& graph = *input.graph;
   const Traversal& traversal = *input.traversal;
   if (++late_generation_ == 0) {  // wrapped: every stamp could look current
@@ -299,7 +298,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, TimeN
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
       const DurationNs travel = traversal.travel(a);
       const DurationNs clearance = traversal.clearance(a);
-      const DurationNs from_start = travel_from_start(input, from);
+      const DurationNs from_start = travel_from_start(input, kind, from);
       if (from_start == kUnreachable) continue;  // no route passes there, whatever the deadline
       const TimeNs earliest = input.start_time + from_start;
       std::uint32_t edge_count = 0;

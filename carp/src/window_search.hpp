@@ -138,16 +138,18 @@ class WindowSearch {
   /// the deadline. Each check it failed compares a time that grows at most as fast as the
   /// deadline with a fixed one; the smallest gap is a margin by which the deadline can grow
   /// with every check still failing, so with no route arriving. Gives up (not proven) after
-  /// `budget` states.
-  LateProof prove_late(const SearchInput& input, TimeNs deadline, std::size_t budget);
+  /// `budget` states. `kind` chooses the bound of travel_from_start.
+  LateProof prove_late(const SearchInput& input, ProofKind kind, TimeNs deadline,
+                       std::size_t budget);
   /// A lower bound of the reservation-free travel time from the start to `vertex`,
   /// kUnreachable if no route passes there: the earliest a route can be there after the
   /// start time. In a full proof the exact time, from a table set up by the first call of
   /// each search (only searches that try a full proof pay for it, about one heuristic
   /// search); in a quick proof the heuristic's triangle inequality, h(start) - h(vertex)
   /// (a route through a vertex that cannot reach the last stop does not exist either).
-  DurationNs travel_from_start(const SearchInput& input, topology::EntityIndex vertex) {
-    if (proof_kind_ == ProofKind::quick) {
+  DurationNs travel_from_start(const SearchInput& input, ProofKind kind,
+                               topology::EntityIndex vertex) {
+    if (kind == ProofKind::quick) {
       const Leg& last = input.legs.back();
       const DurationNs to_stop = last.table->distance(*input.graph, *input.traversal, vertex);
       if (to_stop == kUnreachable) return kUnreachable;
@@ -268,7 +270,6 @@ class WindowSearch {
   std::vector<LateLabel> late_labels_;     // per window id, valid where stamped
   std::vector<std::uint32_t> late_stamp_;  // per window id
   std::uint32_t late_generation_ = 0;
-  ProofKind proof_kind_ = ProofKind::full;   // of the proof running (travel_from_start)
   ReachTable from_start_;                    // see travel_from_start
   std::uint32_t from_start_generation_ = 0;  // generation_ of the search it was set up for
   std::uint32_t sequence_ = 0;

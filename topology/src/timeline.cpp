@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cassert>
 #include <functional>
-#include <limits>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -64,6 +63,11 @@ std::uint64_t TimelineSet::Impl::next_revision() {
   return last.fetch_add(1, std::memory_order_relaxed) + 1;
 }
 
+void TimelineSet::Impl::revise_all(TimelineSet& set) {
+  const std::uint64_t revision = next_revision();
+  for (EntityIndex e = 0; e < set.revisions_.of.size(); ++e) revise(set, e, revision);
+}
+
 void TimelineSet::Impl::revise_around(TimelineSet& set, EntityIndex entity) {
   const std::uint64_t revision = next_revision();
   revise(set, entity, revision);
@@ -104,13 +108,9 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
       owned_(owned_flags(std::move(owned), conflict_sets_.size())),
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
-      revisions_{std::vector<std::uint64_t>(conflict_sets_.size(), Impl::next_revision())},
+      revisions_{std::vector<std::uint64_t>(conflict_sets_.size())},
       newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size())} {
-  for (EntityIndex e = 0; e < conflict_sets_.size(); ++e) {
-    if (owns(e)) {
-      newcomers_.of[e].windows.push_back(Interval{std::numeric_limits<TimeNs>::min(), kForever});
-    }
-  }
+  Impl::revise_all(*this);
 }
 
 std::size_t TimelineSet::entity_count() const noexcept { return timelines_.size(); }

@@ -35,6 +35,8 @@ struct TimelineSet::Impl {
   /// timeline (a newcomer's windows). Every change of what free windows read goes through
   /// here, after the change.
   static void revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision);
+  /// Revises every entity, with one fresh revision (a set made or restored).
+  static void revise_all(TimelineSet& set);
   /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.
   template <class Skip>
   static void sweep(const TimelineSet& set, EntityIndex entity, TimeNs from, TimeNs until,

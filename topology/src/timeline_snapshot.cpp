@@ -273,9 +273,7 @@ Result<TimelineSet> TimelineSet::restore(std::vector<std::vector<EntityIndex>> c
       set.held_[es.entity] = es.holding->step;
     }
   }
-  // Fresh revisions for every entity, after the timelines are filled in.
-  const std::uint64_t revision = Impl::next_revision();
-  for (EntityIndex e = 0; e < set.revisions_.of.size(); ++e) Impl::revise(set, e, revision);
+  Impl::revise_all(set);  // after the timelines are filled in
   set.next_lock_id_ = snapshot.next_lock_id;
   set.next_prepare_id_ = snapshot.next_prepare_id;
   return set;
