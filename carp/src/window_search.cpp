@@ -142,7 +142,7 @@ TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
       if (input.traversal->usable_arc(a)) floor = std::min(floor, arrival_over(input, a, floor));
     }
   }
-  return floor == kForever ? input.start_time : floor;
+  return floor;
 }
 
 TimeNs WindowSearch::held_after(const SearchInput& input, TimeNs at) {
@@ -423,6 +423,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   // Every state's key is at least this: states that could only reach the goal before it
   // is free would otherwise all be expanded first, in order of a bound that cannot be met.
   arrival_floor_ = arrival_floor(input);
+  if (arrival_floor_ == kForever) return outcome;  // the stop can never be entered and held
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
   improve(states_of(input, 0, input.start), input.start_time, input.start_time, kNone, kNone,

@@ -107,7 +107,8 @@ class WindowSearch {
   /// a free window long enough for the hold, or open-ended), looking one step back: unless
   /// the last leg starts on the stop, the vehicle drives in along an arc whose edge must be
   /// free from `travel` before to `clearance` after (such edges often stay blocked a little
-  /// longer than the stop, by the same passing vehicle). input.start_time if none.
+  /// longer than the stop, by the same passing vehicle). kForever if the stop can never be
+  /// entered and held: then no route arrives.
   TimeNs arrival_floor(const SearchInput& input);
   /// The earliest time >= `at` from which the last stop can be held, kForever if none.
   TimeNs held_after(const SearchInput& input, TimeNs at);

@@ -224,6 +224,27 @@ TEST(Planner, NamesTheAgentsStandingForGoodInTheWayAsBlockers) {
   EXPECT_TRUE(plan_error(locked, request_to(locked, "a", "0,0", {open_stop(locked, "4,0")})).blockers.empty());
 }
 
+TEST(Planner, FailsWithoutASearchWhenNoEdgeIntoTheGoalIsEverFreeToStay) {
+  // b and c stand for good on both sides of the goal: no edge into it is ever free again,
+  // which the arrival floor shows before any state is expanded (a search would otherwise
+  // try every window it can reach within the horizon).
+  World w(GridBuilder().corridor(7).build());
+  w.occupy("b", "2,0", sec(0), kForever);
+  w.occupy("c", "4,0", sec(0), kForever);
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "3,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_EQ(e.blockers, std::vector<std::string>{"b"}) << e.message;
+  EXPECT_EQ(w.planner.last_stats().arrival_floor, kForever);
+  // Once c leaves, the goal is still out of reach behind b, but no longer provably so
+  // from the goal alone: the search runs.
+  World open(GridBuilder().corridor(7).build());
+  open.occupy("b", "2,0", sec(0), kForever);
+  open.occupy("c", "4,0", sec(0), sec(5));
+  EXPECT_EQ(plan_error(open, request_to(open, "a", "0,0", {open_stop(open, "3,0")})).reason,
+            PlanFailure::no_window);
+  EXPECT_LT(open.planner.last_stats().arrival_floor, kForever);
+}
+
 TEST(Planner, ReportsWhyTheStartIsNotFree) {
   World w(GridBuilder().corridor(3).build());
   w.occupy("b", "0,0", sec(0), sec(10));
