@@ -92,7 +92,8 @@ void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, st
                             std::vector<std::string>& holders) {
   if (!timelines.owns(entity)) return;
   for (const topology::Reservation& r : timelines.timeline(entity).reservations) {
-    if (r.agent != agent && r.window.end == kForever) holders.push_back(r.agent);
+    // The window first: most reservations end, and comparing it is cheaper than the agent.
+    if (r.window.end == kForever && r.agent != agent) holders.push_back(r.agent);
   }
 }
 

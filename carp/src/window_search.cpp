@@ -490,6 +490,7 @@ Route WindowSearch::route(const SearchInput& input) const {
   std::reverse(chain.begin(), chain.end());
 
   Route route;
+  route.steps.reserve(2 * chain.size());  // a vertex per state, an edge between two
   for (std::size_t i = 0; i < chain.size(); ++i) {
     const State& state = states_[chain[i]];
     if (i > 0) {
