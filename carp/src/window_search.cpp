@@ -48,13 +48,14 @@ void WindowSearch::begin(const SearchInput& input) {
   states_.clear();
   open_.clear();
   sequence_ = 0;
-  goal_state_ = kNone;
   arrival_floor_ = 0;
   floor_pops_ = 0;
   next_proof_at_ = input.floor_proof_after;
   proof_budget_ = input.floor_proof_budget;
   floor_proofs_ = 0;
   floor_raises_ = 0;
+  proof_routes_ = 0;
+  path_.clear();
 }
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
@@ -171,33 +172,40 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   return kForever;
 }
 
-bool WindowSearch::raise_arrival_floor(const SearchInput& input, ProofKind kind) {
-  if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return true;
+WindowSearch::FloorProof WindowSearch::raise_arrival_floor(const SearchInput& input,
+                                                           ProofKind kind) {
+  if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return FloorProof::go_on;
   const TimeNs floor = arrival_floor_;
   const std::size_t budget = kind == ProofKind::quick ? input.quick_proof_budget : proof_budget_;
   for (int round = 0; round < kLateProofRounds; ++round) {
     const LateProof proof = prove_late(input, kind, arrival_floor_, budget);
     ++floor_proofs_;
+    if (proof.reached_start && arrival_floor_ <= input.deadline) {
+      // A route arrives by the floor, and none earlier: the earliest arrival.
+      follow_labels(input);
+      ++proof_routes_;
+      return FloorProof::route_found;
+    }
     if (!proof.proven) break;
     ++floor_raises_;
     if (proof.margin == kForever) {
       arrival_floor_ = kForever;
-      return false;
+      return FloorProof::no_route;
     }
     arrival_floor_ += proof.margin;
   }
   if (arrival_floor_ == floor) {
-    if (kind == ProofKind::quick) return true;  // tried once per floor
+    if (kind == ProofKind::quick) return FloorProof::go_on;  // tried once per floor
     proof_budget_ *= 4;
     next_proof_at_ *= 4;
-    return true;
+    return FloorProof::go_on;
   }
   floor_pops_ = 0;
   next_proof_at_ = input.floor_proof_after;
   // Every open key is at least the new floor; entries of states closed since are dropped.
   open_.rebuild([this](const OpenEntry& e) { return !states_[e.state].closed; },
                 [this](OpenEntry& e) { e.f = std::max(e.ready + e.h, arrival_floor_); });
-  return true;
+  return FloorProof::go_on;
 }
 
 // Why a proof is sound (reviewed 2026-11-25). Take any route of the forward model (drive)
@@ -246,7 +254,9 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
     if (cap >= needed) margin = std::min(margin, needed - latest);
   };
   // A state is expanded again when only its cap grew: its successors' caps may grow too.
-  const auto reach = [this](EntityIndex vertex, std::uint32_t window, TimeNs latest, TimeNs cap) {
+  // `from_start`: travel_from_start of the vertex.
+  const auto reach = [this, kind](EntityIndex vertex, std::uint32_t window, DurationNs from_start,
+                            TimeNs latest, TimeNs cap) {
     if (late_stamp_.size() < window_ids_) {
       late_stamp_.resize(window_ids_, 0);
       late_labels_.resize(window_ids_);
@@ -260,7 +270,8 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
       late_stamp_[id] = late_generation_;
       label = LateLabel{latest, cap};
     }
-    late_open_.push(LateEntry{label.latest, label.cap, window, id, vertex});
+    const TimeNs rank = kind == ProofKind::full ? label.latest - from_start : label.latest;
+    late_open_.push(LateEntry{rank, label.latest, label.cap, window, id, vertex});
   };
   // Window starts before the start time read as the start time, as when the windows were
   // read from it (the proof's margins compare with them).
@@ -276,7 +287,8 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
   }
   const Interval held = clipped(goal_windows[goal_count - 1]);
   if (held.start > deadline) return LateProof{true, held.start - deadline};
-  reach(input.legs.back().stop, goal_count - 1, deadline, kForever);
+  const EntityIndex stop = input.legs.back().stop;
+  reach(stop, goal_count - 1, travel_from_start(input, kind, stop), deadline, kForever);
   std::uint32_t start_count = 0;
   windows_of(input, input.start, start_count);  // the start's first window is its window 0
 
@@ -288,7 +300,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
     if (++visited > budget) return LateProof{};
     if (top.vertex == input.start && top.window == 0) {
       // The search's first state: ready at the start time, and never reached again.
-      if (top.latest >= input.start_time) return LateProof{};
+      if (top.latest >= input.start_time) return LateProof{false, 0, true};
       fails_by(input.start_time, top.latest, top.cap);
       continue;
     }
@@ -336,7 +348,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
             fails_by(earliest, latest, cap);
             continue;
           }
-          reach(from, j, latest, cap);
+          reach(from, j, from_start, latest, cap);
         }
       }
     }
@@ -366,8 +378,9 @@ void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
   open_.push(open_entry(ready, estimate, state));
 }
 
-void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
-                         const Traversal::Move& move, SearchOutcome& outcome) {
+template <class Arrive>
+[[gnu::always_inline]] inline void WindowSearch::arrivals(const SearchInput& input, const State& current,
+                            const Traversal::Move& move, Arrive&& arrive) {
   const DurationNs travel = move.travel;
   const DurationNs clearance = move.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
@@ -379,8 +392,6 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
   // The destination's windows are read only once the edge is known to lead somewhere:
   // reading a timeline is the dearest part of a move.
   const Interval* vertex_first = nullptr;
-  std::uint32_t block = kNone;
-  DurationNs to_go = -1;  // the heuristic of a.to, looked up only if a state improves
   for (std::uint32_t i = ending_after(edge_first, edge_count, current.ready); i < edge_count; ++i) {
     const Interval edge = edge_first[i];
     if (edge.start > latest_onto_edge) break;
@@ -393,17 +404,64 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
          j < vertex_count; ++j) {
       const Interval window = vertex_first[j];
       if (window.start > latest_arrival) break;
-      const TimeNs arrival = std::max(earliest_arrival, window.start);
-      if (arrival > input.deadline) {
-        outcome.horizon_cut = true;
-        break;  // later windows are later still
-      }
-      if (block == kNone) block = states_of(input, current.layer, move.to);
-      if (arrival >= states_[block + j].ready) continue;
-      if (to_go < 0) to_go = estimate(input, current.layer, move.to);
-      if (to_go == kUnreachable) return;
-      improve(block + j, arrival, arrival, from, move.arc, onto_edge, to_go);
+      if (!arrive(j, onto_edge, std::max(earliest_arrival, window.start))) break;
     }
+  }
+}
+
+void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
+                         const Traversal::Move& move, SearchOutcome& outcome) {
+  std::uint32_t block = kNone;
+  DurationNs to_go = -1;  // the heuristic of move.to, looked up only if a state improves
+  arrivals(input, current, move, [&](std::uint32_t j, TimeNs onto_edge, TimeNs arrival) {
+    if (arrival > input.deadline) {
+      outcome.horizon_cut = true;
+      return false;  // later windows are later still
+    }
+    if (block == kNone) block = states_of(input, current.layer, move.to);
+    if (arrival >= states_[block + j].ready) return true;
+    if (to_go < 0) to_go = estimate(input, current.layer, move.to);
+    if (to_go == kUnreachable) return false;  // nor any other window of move.to
+    improve(block + j, arrival, arrival, from, move.arc, onto_edge, to_go);
+    return true;
+  });
+}
+
+// Why a successor always exists (the converse of prove_late's soundness): a state's label
+// L was set from a successor s' (label L' then, never less since) over an arc, edge window e
+// and window W, as min(min(L', e.end - clearance) - travel, W.end - clearance), after
+// checking e.start <= that and W.end - clearance >= e.start. Ready at r <= L, the vehicle
+// enters e at y = max(r, e.start) <= min(L', e.end - clearance) - travel, with
+// y + clearance <= W.end, and arrives in s' at max(y + travel, start of s') <=
+// min(L', e.end - clearance) (a label is never below its window's start): within L'. Time
+// grows by at least the travel with each step and stays within the deadline, so the walk
+// ends, in the last stop's open-ended window (the only completing state with a label).
+void WindowSearch::follow_labels(const SearchInput& input) {
+  const Leg& last = input.legs.back();
+  State at{input.start_time, input.start_time, 0, kNone, kNone, input.start, 0, 0, false};
+  path_.assign(1, at);
+  while (at.vertex != last.stop || !completes(input, at)) {
+    State next{};
+    DurationNs next_h = kUnreachable;
+    for (const Traversal::Move& move : input.traversal->adjacency(*input.graph).out_of(at.vertex)) {
+      const DurationNs h = last.table->distance(*input.graph, *input.traversal, move.to);
+      if (h > next_h) continue;
+      arrivals(input, at, move, [&](std::uint32_t j, TimeNs onto_edge, TimeNs arrival) {
+        const std::uint32_t id = window_id(move.to, j);
+        if (id >= late_stamp_.size() || late_stamp_[id] != late_generation_ ||
+            arrival > late_labels_[id].latest) {
+          return true;  // no route on from there by the deadline; a later window may have one
+        }
+        if (h < next_h || arrival < next.ready) {
+          next = State{arrival, arrival, onto_edge, kNone, move.arc, move.to, j, 0, false};
+          next_h = h;
+        }
+        return false;  // later windows of this edge window are reached later
+      });
+    }
+    // Never without a successor: the label of `at` came from one (see above).
+    at = next;
+    path_.push_back(at);
   }
 }
 
@@ -435,11 +493,13 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
     if (popped.closed || top.ready != popped.ready) continue;  // stale entry
     if (top.f == arrival_floor_) {
       ++floor_pops_;
-      if (floor_pops_ == input.quick_proof_after &&
-          !raise_arrival_floor(input, ProofKind::quick)) {
-        return outcome;
+      FloorProof proof = FloorProof::go_on;
+      if (floor_pops_ == input.quick_proof_after) proof = raise_arrival_floor(input, ProofKind::quick);
+      if (proof == FloorProof::go_on && floor_pops_ == next_proof_at_) {
+        proof = raise_arrival_floor(input, ProofKind::full);
       }
-      if (floor_pops_ == next_proof_at_ && !raise_arrival_floor(input, ProofKind::full)) {
+      if (proof != FloorProof::go_on) {
+        outcome.found = proof == FloorProof::route_found;
         return outcome;
       }
       if (top.f < arrival_floor_) {  // the key rose: back to the open list
@@ -451,7 +511,10 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
     const State current = popped;  // states_ may grow below
     if (current.vertex == input.legs[current.layer].stop &&
         current.layer + 1u == input.legs.size() && completes(input, current)) {
-      goal_state_ = top.state;
+      for (std::uint32_t s = top.state; s != kNone; s = states_[s].parent) {
+        path_.push_back(states_[s]);
+      }
+      std::reverse(path_.begin(), path_.end());
       outcome.found = true;
       return outcome;
     }
@@ -485,16 +548,12 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
 Route WindowSearch::route(const SearchInput& input) const {
   const RoutingGraph& graph = *input.graph;
   const Traversal& traversal = *input.traversal;
-  std::vector<std::uint32_t> chain;
-  for (std::uint32_t s = goal_state_; s != kNone; s = states_[s].parent) chain.push_back(s);
-  std::reverse(chain.begin(), chain.end());
-
   Route route;
-  route.steps.reserve(2 * chain.size());  // a vertex per state, an edge between two
-  for (std::size_t i = 0; i < chain.size(); ++i) {
-    const State& state = states_[chain[i]];
+  route.steps.reserve(2 * path_.size());  // a vertex per state, an edge between two
+  for (std::size_t i = 0; i < path_.size(); ++i) {
+    const State& state = path_[i];
     if (i > 0) {
-      const State& previous = states_[chain[i - 1]];
+      const State& previous = path_[i - 1];
       if (state.arc == kNone) {  // a stop was made at the previous state; the step goes on
         route.stop_steps.push_back(route.steps.size() - 1);
         route.stop_arrivals.push_back(previous.ready);
@@ -509,7 +568,7 @@ Route WindowSearch::route(const SearchInput& input) const {
     }
     route.steps.push_back(topology::RouteStep{state.vertex, Interval{state.entry, 0}});
   }
-  const State& goal = states_[goal_state_];
+  const State& goal = path_.back();
   const DurationNs hold = input.legs.back().dwell;
   route.steps.back().window.end = hold == kForever ? kForever : goal.ready + hold;
   route.stop_steps.push_back(route.steps.size() - 1);

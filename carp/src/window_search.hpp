@@ -65,7 +65,7 @@ class WindowSearch {
   Route route(const SearchInput& input) const;
   /// What the last run() did.
   PlanStats stats() const {
-    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_};
+    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_, proof_routes_};
   }
 
  private:
@@ -121,16 +121,24 @@ class WindowSearch {
   /// The two kinds of floor proof: quick ones bound how early a route can be at a vertex
   /// by the heuristic alone and visit few states; full ones use the exact forward table.
   enum class ProofKind { quick, full };
+  /// What raise_arrival_floor found.
+  enum class FloorProof {
+    go_on,        ///< the floor rose, or stayed: the search goes on
+    no_route,     ///< no route ever arrives (a certificate of failure)
+    route_found,  ///< a route arrives at the floor, the earliest possible: it is in path_
+  };
   /// Raises arrival_floor_ while prove_late proves that no route arrives by it, and re-keys
   /// the open list. Only for one open-ended stop. Called once a search has expanded many
   /// states keyed by the floor: all that could arrive by the floor share it as key, and with
-  /// a floor below the arrival every one of them must be expanded.
-  /// \return false when no route can ever arrive (a certificate of failure).
-  bool raise_arrival_floor(const SearchInput& input, ProofKind kind);
+  /// a floor below the arrival every one of them must be expanded. A proof that reaches the
+  /// start instead shows a route arriving by the floor, which no route beats: its labels
+  /// lead to it (follow_labels), and the search is over.
+  FloorProof raise_arrival_floor(const SearchInput& input, ProofKind kind);
   /// What a backward search from the last stop found about arrivals by a deadline.
   struct LateProof {
     bool proven = false;     ///< no route arrives by the deadline
     DurationNs margin = 0;   ///< if proven: nor by deadline + margin - 1 ns; kForever: never
+    bool reached_start = false;  ///< a route arrives by the deadline (follow_labels finds it)
   };
   /// A backward search over (vertex, free window) states from the open-ended window of the
   /// last stop, labelled with the latest time the vehicle may be ready there and still arrive
@@ -142,6 +150,11 @@ class WindowSearch {
   /// `budget` states. `kind` chooses the bound of travel_from_start.
   LateProof prove_late(const SearchInput& input, ProofKind kind, TimeNs deadline,
                        std::size_t budget);
+  /// After prove_late reached the start: the route its labels lead to, from the start state
+  /// ready at the start time, into path_. At each state it drives to the successor closest
+  /// to the goal (then the earliest) whose label it reaches by: a label is the latest the
+  /// vehicle may be ready there and still arrive by the deadline, so one always exists.
+  void follow_labels(const SearchInput& input);
   /// A lower bound of the reservation-free travel time from the start to `vertex`,
   /// kUnreachable if no route passes there: the earliest a route can be there after the
   /// start time. In a full proof the exact time, from a table set up by the first call of
@@ -227,6 +240,14 @@ class WindowSearch {
                   topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
+  /// Calls arrive(j, onto_edge, arrival) for every window j of move.to that the vehicle
+  /// reaches from `current` by `move`: entering the edge at `onto_edge`, arriving at
+  /// `arrival`, both the earliest possible; in order of the edge's windows, and for each of
+  /// the destination's windows in order. When arrive returns false, the destination's later
+  /// windows are skipped for that edge window (they are reached later still).
+  template <class Arrive>
+  void arrivals(const SearchInput& input, const State& current, const Traversal::Move& move,
+                Arrive&& arrive);
   /// Drives `move` from state `from` (`current`, a copy: states_ may grow) into every
   /// window of its destination it can reach.
   void drive(const SearchInput& input, std::uint32_t from, const State& current,
@@ -259,13 +280,24 @@ class WindowSearch {
   };
   /// An open state of that search: window `window` of `vertex` (its id is `id`). The
   /// latest first.
+  /// An open state of that search: window `window` of `vertex` (its id is `id`), the
+  /// highest rank first. In a full proof the rank is the slack: the latest the vehicle may
+  /// be ready there, less the earliest it can be there (the forward table's exact time), so
+  /// that the search heads for the start like an A* and, when the floor can be met, reaches
+  /// it soon, with a route (warehouse N = 200: 7 % fewer planner instructions than latest
+  /// first). In a quick proof, whose earliest times are loose, the rank is the latest time
+  /// (slack ranks measured no better). Among equal ranks, the state reached earliest first.
+  /// Any order gives the same labels when a proof runs to its end (see prove_late).
   struct LateEntry {
+    TimeNs rank;
     TimeNs latest;
     TimeNs cap;
     std::uint32_t window;
     std::uint32_t id;
     topology::EntityIndex vertex;
-    bool operator>(const LateEntry& o) const { return latest < o.latest; }
+    bool operator>(const LateEntry& o) const {
+      return rank != o.rank ? rank < o.rank : latest > o.latest;
+    }
   };
   MinHeap<LateEntry> late_open_;
   std::vector<LateLabel> late_labels_;     // per window id, valid where stamped
@@ -280,7 +312,8 @@ class WindowSearch {
   std::size_t proof_budget_ = 0;   // backward states prove_late may visit
   std::size_t floor_proofs_ = 0;   // prove_late calls in this search
   std::size_t floor_raises_ = 0;   // of which proven
-  std::uint32_t goal_state_ = kNone;
+  std::size_t proof_routes_ = 0;   // 1 when a proof found the route
+  std::vector<State> path_;  // the route found, from the start state to the goal's
 };
 
 }  // namespace drover::carp

@@ -247,14 +247,20 @@ PlanRequest random_request(const World& w, std::mt19937& rng, bool open_ended_on
 /// (which must never pass the earliest arrival, whatever the search's luck in finding it).
 /// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
 /// proof budgets (1 to 32 states), so that proofs also give up and try again.
-/// `raised`: in how many trials a backward proof raised the floor.
+/// What the backward proofs did over the trials of check_against_brute_force.
+struct ProofUse {
+  int raised = 0;  ///< trials in which a proof raised the floor
+  int routes = 0;  ///< trials whose route a proof found (it reached the start)
+};
+
+/// `use`: what the proofs did, if asked.
 void check_against_brute_force(PlannerOptions options, int trials, bool open_ended_only = false,
-                               int* raised = nullptr) {
+                               ProofUse* use = nullptr) {
   const std::size_t budget = options.floor_proof_budget;
   const std::size_t quick_budget = options.quick_proof_budget;
   std::mt19937 rng(20240611);
   int found = 0, refused = 0;
-  if (raised != nullptr) *raised = 0;
+  if (use != nullptr) *use = ProofUse{};
   for (int trial = 0; trial < trials; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial));
     const bool small = open_ended_only && trial % 4 == 3;
@@ -266,7 +272,10 @@ void check_against_brute_force(PlannerOptions options, int trials, bool open_end
     const auto expected = BruteForce(w.topology, blockers, request).earliest_arrival();
     const auto planned = w.planner.plan(w.timelines, request);
     const PlanStats stats = w.planner.last_stats();
-    if (raised != nullptr && stats.floor_raises > 0) ++*raised;
+    if (use != nullptr) {
+      use->raised += stats.floor_raises > 0 ? 1 : 0;
+      use->routes += static_cast<int>(stats.proof_routes);
+    }
     if (expected) {
       // A floor past the earliest arrival is a wrong proof even when the search happens to
       // pop the earliest completed state first anyway.
@@ -306,27 +315,32 @@ TEST(PlannerRandom, RoutesAreValidCollisionFreeAndArriveAtTheEarliestPossibleTim
 // After each raise the next proof comes one floor-keyed expansion later, so the floor is
 // pushed up to where no proof holds: right below the earliest arrival, where a proof that
 // claims too much shows. Checked: the final floor and the arrival against the brute force.
+// A proof at a floor the route meets reaches the start instead, and the route is the one
+// its labels lead to: those are checked like the search's own.
 TEST(PlannerRandom, RaisingTheArrivalFloorByProofsKeepsTheEarliestArrival) {
-  int raised = 0;
+  ProofUse use;
   check_against_brute_force(PlannerOptions{.horizon = sec(1000),
                                            .quick_proof_after = 0,
                                            .floor_proof_after = 1,
                                            .floor_proof_budget = 1 << 20},
-                            1200, true, &raised);
-  EXPECT_GT(raised, 150) << raised;  // the proofs must have been put to work
+                            1200, true, &use);
+  // The proofs must have been put to work, both ways.
+  EXPECT_GT(use.raised, 150) << use.raised;
+  EXPECT_GT(use.routes, 300) << use.routes;
 }
 
 // The same for quick proofs alone (how early a route reaches a vertex bounded by the
 // heuristic's triangle inequality, not by the forward table): one after every floor-keyed
 // expansion, as each raise starts the count again.
 TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) {
-  int raised = 0;
+  ProofUse use;
   check_against_brute_force(PlannerOptions{.horizon = sec(1000),
                                            .quick_proof_after = 1,
                                            .quick_proof_budget = 1 << 20,
                                            .floor_proof_after = std::size_t{1} << 40},
-                            1200, true, &raised);
-  EXPECT_GT(raised, 150) << raised;
+                            1200, true, &use);
+  EXPECT_GT(use.raised, 150) << use.raised;
+  EXPECT_GT(use.routes, 300) << use.routes;
 }
 
 TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {

@@ -42,6 +42,7 @@ struct PlanStats {
   TimeNs arrival_floor = 0;
   std::size_t floor_proofs = 0;  ///< backward proofs tried
   std::size_t floor_raises = 0;  ///< proofs that raised the floor
+  std::size_t proof_routes = 0;  ///< 1 when a proof found the route (it reached the start)
 };
 
 /// The route planner of a routing agent. It keeps search memory and heuristic tables
