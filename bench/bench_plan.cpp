@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <ctime>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -94,7 +95,12 @@ double run_astar(const std::shared_ptr<const carp::RoutingGraph>& graph,
 CarpRun run_carp(const std::shared_ptr<const carp::RoutingGraph>& graph,
                  const std::vector<Agent>& agents, const carp::VehicleProfile& vehicle) {
   topology::TimelineSet timelines(graph->topology().conflict_sets());
-  carp::Planner planner(graph);
+  carp::PlannerOptions options;
+  if (getenv("QA")) options.quick_proof_after = atoi(getenv("QA"));
+  if (getenv("QB")) options.quick_proof_budget = atoi(getenv("QB"));
+  if (getenv("FA")) options.floor_proof_after = atoi(getenv("FA"));
+  if (getenv("FB")) options.floor_proof_budget = atoi(getenv("FB"));
+  carp::Planner planner(graph, options);
   CarpRun run;
   run.outcomes.resize(agents.size());
   for (std::size_t i = 0; i < agents.size(); ++i) {

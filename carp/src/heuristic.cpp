@@ -41,6 +41,7 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
   };
   if (!queued_root_) {
     queued_root_ = true;
+    if (breadth_first) fifo_.reserve(graph.vertex_count());  // each vertex is queued once
     queue(root_, 0);
   }
   const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
