@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <ctime>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -95,12 +94,7 @@ double run_astar(const std::shared_ptr<const carp::RoutingGraph>& graph,
 CarpRun run_carp(const std::shared_ptr<const carp::RoutingGraph>& graph,
                  const std::vector<Agent>& agents, const carp::VehicleProfile& vehicle) {
   topology::TimelineSet timelines(graph->topology().conflict_sets());
-  carp::PlannerOptions options;
-  if (getenv("QA")) options.quick_proof_after = atoi(getenv("QA"));
-  if (getenv("QB")) options.quick_proof_budget = atoi(getenv("QB"));
-  if (getenv("FA")) options.floor_proof_after = atoi(getenv("FA"));
-  if (getenv("FB")) options.floor_proof_budget = atoi(getenv("FB"));
-  carp::Planner planner(graph, options);
+  carp::Planner planner(graph);
   CarpRun run;
   run.outcomes.resize(agents.size());
   for (std::size_t i = 0; i < agents.size(); ++i) {

@@ -26,12 +26,13 @@ struct PlannerOptions {
   std::size_t quick_proof_budget = 16;
   /// After expanding this many states keyed by the arrival floor, a search tries a full
   /// proof (with the exact earliest times from the start, a forward table); four times as
-  /// many before each further try. Any value >= 1 gives the same arrivals; 512 paid off best
-  /// on the benchmark's maps (128, 256, 1024 tried; docs/benchmarks.md).
-  std::size_t floor_proof_after = 512;
+  /// many before each further try. A full proof that reaches the start has found the route
+  /// instead. Any value >= 1 gives the same arrivals; 256 paid off best on the benchmark's
+  /// maps since proofs find routes (192, 384, 512 tried; docs/benchmarks.md).
+  std::size_t floor_proof_after = 256;
   /// How many backward states such a proof may visit before it gives up; four times as many
   /// at each further try. Any value >= 1 gives the same arrivals; 128 paid off best (64,
-  /// 256, 1024 tried).
+  /// 192, 256, 512, 1024 tried).
   std::size_t floor_proof_budget = 128;
 };
 
