@@ -91,6 +91,9 @@ std::string forever_blocker_text(const topology::Topology& topology, const Timel
 void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, std::string_view agent,
                             std::vector<std::string>& holders) {
   if (!timelines.owns(entity)) return;
+  // Nobody holds it open-ended when a newcomer can have it for good: most entities.
+  const std::vector<Interval>& free = timelines.newcomer_windows(entity).windows;
+  if (!free.empty() && free.back().end == kForever) return;
   for (const topology::Reservation& r : timelines.timeline(entity).reservations) {
     // The window first: most reservations end, and comparing it is cheaper than the agent.
     if (r.window.end == kForever && r.agent != agent) holders.push_back(r.agent);
