@@ -26,6 +26,8 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
   // every arc takes the same time, a first-in first-out queue pops in order of distance
   // (breadth-first search): no keys, no division, each vertex queued once.
   const bool breadth_first = traversal.uniform();
+  // Breadth-first, a vertex's first distance is its shortest: no need to wait for its pop.
+  if (breadth_first && label_[vertex] != kUnreachable) return label_[vertex];
   const DurationNs unit = traversal.min_travel();
   const auto queue = [&](EntityIndex next, DurationNs through) {
     if (breadth_first) {
