@@ -278,8 +278,6 @@ class WindowSearch {
     TimeNs latest = 0;
     TimeNs cap = 0;
   };
-  /// An open state of that search: window `window` of `vertex` (its id is `id`). The
-  /// latest first.
   /// An open state of that search: window `window` of `vertex` (its id is `id`), the
   /// highest rank first. In a full proof the rank is the slack: the latest the vehicle may
   /// be ready there, less the earliest it can be there (the forward table's exact time), so
