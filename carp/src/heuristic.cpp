@@ -11,8 +11,8 @@ void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex roo
   root_ = root;
   label_.assign(graph.vertex_count(), kUnreachable);
   open_.clear();
-  fifo_.clear();
   fifo_head_ = 0;
+  fifo_tail_ = 0;
   label_[root] = 0;
   queued_root_ = false;  // the first resume queues it, knowing the traversal
 }
@@ -20,35 +20,23 @@ void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex roo
 template <Direction kDirection>
 DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
                                              const Traversal& traversal, EntityIndex vertex) {
+  if (traversal.uniform()) return breadth_first(graph, traversal, vertex);
   // Keys are distances in units of the shortest arc's travel time, rounded down (Dinitz):
   // whatever the order among equal keys, a vertex's distance is final when it is popped,
-  // since every arc into it comes from a vertex with a smaller key, popped before. When
-  // every arc takes the same time, a first-in first-out queue pops in order of distance
-  // (breadth-first search): no keys, no division, each vertex queued once.
-  const bool breadth_first = traversal.uniform();
-  // Breadth-first, a vertex's first distance is its shortest: no need to wait for its pop.
-  if (breadth_first && label_[vertex] != kUnreachable) return label_[vertex];
+  // since every arc into it comes from a vertex with a smaller key, popped before.
   const DurationNs unit = traversal.min_travel();
-  const auto queue = [&](EntityIndex next, DurationNs through) {
-    if (breadth_first) {
-      fifo_.push_back(next);
-    } else {
-      open_.push(static_cast<std::uint64_t>(through / unit), next);
-    }
-  };
   const auto relax = [&](EntityIndex next, DurationNs through) {
     if (through >= label_[next]) return;  // closed, or no better
     label_[next] = through;
-    queue(next, through);
+    open_.push(static_cast<std::uint64_t>(through / unit), next);
   };
   if (!queued_root_) {
     queued_root_ = true;
-    if (breadth_first) fifo_.reserve(graph.vertex_count());  // each vertex is queued once
-    queue(root_, 0);
+    open_.push(0, root_);
   }
   const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
-  while (breadth_first ? fifo_head_ < fifo_.size() : !open_.empty()) {
-    const EntityIndex top = breadth_first ? fifo_[fifo_head_++] : open_.pop().value;
+  while (!open_.empty()) {
+    const EntityIndex top = open_.pop().value;
     const DurationNs distance = label_[top];
     if (distance < 0) continue;  // stale: popped before
     label_[top] = ~distance;
@@ -61,6 +49,40 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
     if (top == vertex) return distance;
   }
   return kUnreachable;  // every vertex connected with the root is closed, and `vertex` is not
+}
+
+// When every arc takes the same time, a first-in first-out queue holds the vertices in order
+// of distance, so a vertex's first distance is its shortest: it is closed (~distance) as soon
+// as it is found, and distance() answers it inline from then on. No keys, no division, each
+// vertex queued once, and only the vertex ids of the arcs read.
+template <Direction kDirection>
+DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
+                                                    const Traversal& traversal,
+                                                    EntityIndex vertex) {
+  if (!queued_root_) {
+    queued_root_ = true;
+    if (fifo_.size() < graph.vertex_count()) fifo_.resize(graph.vertex_count());
+    fifo_[fifo_tail_++] = root_;
+    label_[root_] = ~DurationNs{0};
+  }
+  const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
+  const DurationNs unit = traversal.min_travel();
+  EntityIndex* const queue = fifo_.data();
+  while (label_[vertex] >= 0 && fifo_head_ < fifo_tail_) {
+    const EntityIndex top = queue[fifo_head_++];
+    const DurationNs through = ~label_[top] + unit;
+    // Backwards to the root (the vertices that can reach top), or onwards from it.
+    const std::span<const EntityIndex> next = kDirection == Direction::to_root
+                                                  ? adjacency.sources_of(top)
+                                                  : adjacency.targets_of(top);
+    for (const EntityIndex v : next) {
+      if (label_[v] != kUnreachable) continue;  // found already, at its shortest
+      label_[v] = ~through;
+      queue[fifo_tail_++] = v;
+    }
+  }
+  // Not found once every vertex connected with the root is.
+  return label_[vertex] < 0 ? ~label_[vertex] : kUnreachable;
 }
 
 template class DistanceTable<Direction::to_root>;

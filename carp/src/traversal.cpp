@@ -105,7 +105,10 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
     adjacency.into_first[v] = static_cast<std::uint32_t>(adjacency.into.size());
     for (const ArcIndex a : graph.arcs_into(v)) {
       const EntityIndex from = graph.arc(a).from;
-      if (usable_arc(a) && usable_vertex(from)) adjacency.into.push_back(Hop{travel(a), from});
+      if (usable_arc(a) && usable_vertex(from)) {
+        adjacency.into.push_back(Hop{travel(a), from});
+        adjacency.into_from.push_back(from);
+      }
     }
     adjacency.out_first[v] = static_cast<std::uint32_t>(adjacency.out.size());
     if (!usable_vertex(v)) continue;
@@ -113,6 +116,7 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
       if (!usable_arc(a)) continue;
       const Arc& arc = graph.arc(a);
       adjacency.out.push_back(Move{travel(a), clearance(a), a, arc.edge, arc.to});
+      adjacency.out_to.push_back(arc.to);
     }
   }
   adjacency.into_first[n] = static_cast<std::uint32_t>(adjacency.into.size());

@@ -67,12 +67,23 @@ class Traversal {
     std::vector<std::uint32_t> into_first, out_first;  // per vertex, and one past the last
     std::vector<Hop> into;
     std::vector<Move> out;
+    // The vertices alone, in the order of `into` and `out`: what a breadth-first search
+    // reads (a quarter and a tenth of the bytes).
+    std::vector<topology::EntityIndex> into_from, out_to;
     std::span<const Hop> into_of(topology::EntityIndex v) const {
       return {into.data() + into_first[v], into.data() + into_first[v + 1]};
     }
     /// None when `v` is not usable.
     std::span<const Move> out_of(topology::EntityIndex v) const {
       return {out.data() + out_first[v], out.data() + out_first[v + 1]};
+    }
+    /// The `from` of into_of(v).
+    std::span<const topology::EntityIndex> sources_of(topology::EntityIndex v) const {
+      return {into_from.data() + into_first[v], into_from.data() + into_first[v + 1]};
+    }
+    /// The `to` of out_of(v).
+    std::span<const topology::EntityIndex> targets_of(topology::EntityIndex v) const {
+      return {out_to.data() + out_first[v], out_to.data() + out_first[v + 1]};
     }
   };
   /// Built on the first call (only the planner asks, not FreePathSearch).
