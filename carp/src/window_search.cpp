@@ -117,7 +117,7 @@ void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::ui
   }
 }
 
-DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
+[[gnu::always_inline]] inline DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
                                   EntityIndex vertex) {
   const Leg& leg = input.legs[layer];
   const DurationNs to_stop = leg.table->distance(*input.graph, *input.traversal, vertex);
@@ -362,7 +362,7 @@ WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estima
                    state};
 }
 
-void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
+[[gnu::always_inline]] inline void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
                            std::uint32_t parent, std::uint32_t arc, TimeNs edge_entry,
                            DurationNs estimate) {
   State& s = states_[state];

@@ -271,7 +271,7 @@ class WindowSearch {
   std::vector<topology::Interval> scratch_;  // an exact query's answer, before it is stored
   std::uint8_t agent_slot_ = 0;   // TimelineSet::AgentBits::slot of the search's agent
   std::vector<State> states_;
-  MinHeap<OpenEntry> open_;
+  DivingMinHeap<OpenEntry> open_;
   /// The label of a state of prove_late's backward search: the latest time the vehicle may
   /// be ready there, and the most that time can become however late the deadline.
   struct LateLabel {
