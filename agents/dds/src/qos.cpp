@@ -42,6 +42,13 @@ fdds::DataWriterQos writer_qos(const TopicQos& qos) {
   // heartbeat period is 3 s, as long as a service call's timeout: a lost reply made a
   // reservation commit time out. Heartbeats go only while samples are unacknowledged.
   out.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100'000'000);
+  // No writer-side content filtering: content-filtered readers filter on their own side.
+  // Fast DDS 2.9 removes a departed remote reader's filter (deleting the filter and its map
+  // entry) on its receive thread without the writer's lock, while write() evaluates the
+  // filters under that lock: a RAN publishing its status as its logical agent stopped
+  // crashed with SIGSEGV in DDSFilterExpression::evaluate.
+  out.writer_resource_limits().reader_filters_allocation =
+      eprosima::fastrtps::ResourceLimitedContainerConfig::fixed_size_configuration(0);
   return out;
 }
 

@@ -31,7 +31,8 @@ struct TopicQos {
   static TopicQos service() { return events(); }
 };
 
-/// The DataWriterQos for `qos` (RELIABLE; write() blocks at most 1 s on a full history).
+/// The DataWriterQos for `qos` (RELIABLE; write() blocks at most 1 s on a full history;
+/// content filters are left to the readers).
 eprosima::fastdds::dds::DataWriterQos writer_qos(const TopicQos& qos);
 
 /// The DataReaderQos for `qos` (RELIABLE, set explicitly).

@@ -2,7 +2,8 @@
 // A content filter class for reply topics: keeps the samples whose header.requester equals
 // the parameter. Fast DDS's default SQL filter evaluates through DynamicData, which costs
 // about 200 us per reply here; this one reads the serialized string in place. Every
-// Participant registers it, so writers filter on their side for their readers too.
+// Participant registers it; readers evaluate it on their side (writer_qos() turns
+// writer-side filtering off).
 
 #include <cstdint>
 #include <string>
