@@ -61,28 +61,38 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
                                                     EntityIndex vertex) {
   if (!queued_root_) {
     queued_root_ = true;
-    if (fifo_.size() < graph.vertex_count()) fifo_.resize(graph.vertex_count());
+    // Each vertex is queued once; one slot more, which the loop below writes past the tail.
+    if (fifo_.size() <= graph.vertex_count()) fifo_.resize(graph.vertex_count() + 1);
     fifo_[fifo_tail_++] = root_;
     label_[root_] = ~DurationNs{0};
   }
   const Traversal::Adjacency& adjacency = traversal.adjacency(graph);
   const DurationNs unit = traversal.min_travel();
   EntityIndex* const queue = fifo_.data();
-  while (label_[vertex] >= 0 && fifo_head_ < fifo_tail_) {
-    const EntityIndex top = queue[fifo_head_++];
-    const DurationNs through = ~label_[top] + unit;
+  DurationNs* const label = label_.data();
+  // In locals: the label stores could alias the members (same type, but for the sign).
+  std::size_t head = fifo_head_, tail = fifo_tail_;
+  while (label[vertex] >= 0 && head < tail) {
+    const EntityIndex top = queue[head++];
+    const DurationNs through = ~label[top] + unit;
     // Backwards to the root (the vertices that can reach top), or onwards from it.
     const std::span<const EntityIndex> next = kDirection == Direction::to_root
                                                   ? adjacency.sources_of(top)
                                                   : adjacency.targets_of(top);
     for (const EntityIndex v : next) {
-      if (label_[v] != kUnreachable) continue;  // found already, at its shortest
-      label_[v] = ~through;
-      queue[fifo_tail_++] = v;
+      // Without a branch (whether a vertex was found already follows no pattern): a vertex
+      // found already keeps its label, at its shortest, and the slot taken stays free.
+      const DurationNs old = label[v];
+      const bool found = old != kUnreachable;
+      label[v] = found ? old : ~through;
+      queue[tail] = v;
+      tail += found ? 0 : 1;
     }
   }
+  fifo_head_ = head;
+  fifo_tail_ = tail;
   // Not found once every vertex connected with the root is.
-  return label_[vertex] < 0 ? ~label_[vertex] : kUnreachable;
+  return label[vertex] < 0 ? ~label[vertex] : kUnreachable;
 }
 
 template class DistanceTable<Direction::to_root>;
