@@ -8,8 +8,16 @@ using topology::EntityIndex;
 
 template <Direction kDirection>
 void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex root) {
+  if (label_.size() != graph.vertex_count() || (queued_root_ && fifo_tail_ == 0)) {
+    label_.assign(graph.vertex_count(), kUnreachable);  // new, or after a Dijkstra search
+  } else if (!queued_root_) {
+    label_[root_] = kUnreachable;  // never searched: only the root was set
+  } else {
+    // Breadth-first, every vertex labelled was queued: clearing those costs a fraction of a
+    // fill on a search that stopped early, and leaves the rest of the table alone in cache.
+    for (std::size_t i = 0; i < fifo_tail_; ++i) label_[fifo_[i]] = kUnreachable;
+  }
   root_ = root;
-  label_.assign(graph.vertex_count(), kUnreachable);
   open_.clear();
   fifo_head_ = 0;
   fifo_tail_ = 0;
