@@ -297,7 +297,7 @@ class WindowSearch {
       return rank != o.rank ? rank < o.rank : latest > o.latest;
     }
   };
-  MinHeap<LateEntry> late_open_;
+  DivingMinHeap<LateEntry> late_open_;
   std::vector<LateLabel> late_labels_;     // per window id, valid where stamped
   std::vector<std::uint32_t> late_stamp_;  // per window id
   std::uint32_t late_generation_ = 0;
