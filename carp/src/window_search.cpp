@@ -117,8 +117,11 @@ void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::ui
   }
 }
 
-[[gnu::always_inline]] inline DurationNs WindowSearch::estimate(const SearchInput& input, std::uint32_t layer,
-                                  EntityIndex vertex) {
+// Inlined, as improve below, into drive's callback (once per state improved): -2 % planner
+// instructions at random N = 200 for the two.
+[[gnu::always_inline]] inline DurationNs WindowSearch::estimate(const SearchInput& input,
+                                                                std::uint32_t layer,
+                                                                EntityIndex vertex) {
   const Leg& leg = input.legs[layer];
   const DurationNs to_stop = leg.table->distance(*input.graph, *input.traversal, vertex);
   return to_stop == kUnreachable ? kUnreachable : to_stop + leg.tail;
@@ -362,9 +365,10 @@ WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estima
                    state};
 }
 
-[[gnu::always_inline]] inline void WindowSearch::improve(std::uint32_t state, TimeNs entry, TimeNs ready,
-                           std::uint32_t parent, std::uint32_t arc, TimeNs edge_entry,
-                           DurationNs estimate) {
+[[gnu::always_inline]] inline void WindowSearch::improve(std::uint32_t state, TimeNs entry,
+                                                        TimeNs ready, std::uint32_t parent,
+                                                        std::uint32_t arc, TimeNs edge_entry,
+                                                        DurationNs estimate) {
   State& s = states_[state];
   if (ready >= s.ready) return;
   // Keys clipped by the arrival floor are not consistent: a state may be closed before its
