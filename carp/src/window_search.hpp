@@ -46,10 +46,11 @@ struct SearchInput {
   std::span<const Leg> legs;
   TimeNs deadline = 0;         ///< states that could only leave later are dropped
   bool count_locks = true;
-  std::size_t quick_proof_after = 64;    ///< PlannerOptions::quick_proof_after
-  std::size_t quick_proof_budget = 16;   ///< PlannerOptions::quick_proof_budget
-  std::size_t floor_proof_after = 512;   ///< PlannerOptions::floor_proof_after
-  std::size_t floor_proof_budget = 128;  ///< PlannerOptions::floor_proof_budget
+  // The planner's options (the defaults taken from there, so that they cannot drift apart).
+  std::size_t quick_proof_after = PlannerOptions{}.quick_proof_after;
+  std::size_t quick_proof_budget = PlannerOptions{}.quick_proof_budget;
+  std::size_t floor_proof_after = PlannerOptions{}.floor_proof_after;
+  std::size_t floor_proof_budget = PlannerOptions{}.floor_proof_budget;
 };
 
 struct SearchOutcome {

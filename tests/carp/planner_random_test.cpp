@@ -242,17 +242,17 @@ PlanRequest random_request(const World& w, std::mt19937& rng, bool open_ended_on
   return request;
 }
 
-/// Plans `trials` random requests on random small grids with random traffic and compares
-/// each with the brute force: the arrival, and the arrival floor the search ended with
-/// (which must never pass the earliest arrival, whatever the search's luck in finding it).
-/// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
-/// proof budgets (1 to 32 states), so that proofs also give up and try again.
 /// What the backward proofs did over the trials of check_against_brute_force.
 struct ProofUse {
   int raised = 0;  ///< trials in which a proof raised the floor
   int routes = 0;  ///< trials whose route a proof found (it reached the start)
 };
 
+/// Plans `trials` random requests on random small grids with random traffic and compares
+/// each with the brute force: the arrival, and the arrival floor the search ended with
+/// (which must never pass the earliest arrival, whatever the search's luck in finding it).
+/// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
+/// proof budgets (1 to 32 states), so that proofs also give up and try again.
 /// `use`: what the proofs did, if asked.
 void check_against_brute_force(PlannerOptions options, int trials, bool open_ended_only = false,
                                ProofUse* use = nullptr) {
