@@ -24,18 +24,16 @@ constexpr int kLateProofRounds = 8;
 
 void WindowSearch::begin(const SearchInput& input) {
   if (++generation_ == 0) {  // wrapped: every stamp could look current
-    std::fill(entity_stamp_.begin(), entity_stamp_.end(), 0);
+    for (EntityWindows& e : entities_) e.stamp = 0;
     std::fill(block_stamp_.begin(), block_stamp_.end(), 0);
     from_start_generation_ = 0;
     generation_ = 1;
   }
   const RoutingGraph& graph = *input.graph;
   const std::size_t entities = graph.topology().entity_count();
-  if (entity_stamp_.size() != entities) {
-    entity_stamp_.assign(entities, 0);
-    entity_count_.assign(entities, 0);
+  if (entities_.size() != entities) {
+    entities_.assign(entities, EntityWindows{});
     entity_ids_.assign(entities, 0);
-    entity_windows_.assign(entities, nullptr);
   }
   agent_slot_ = topology::TimelineSet::AgentBits::slot(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
@@ -59,7 +57,6 @@ void WindowSearch::begin(const SearchInput& input) {
 }
 
 void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
-  entity_stamp_[entity] = generation_;
   const Interval* first = nullptr;
   std::uint32_t count = 0;
   const topology::TimelineSet::NewcomerWindows& newcomer =
@@ -81,8 +78,7 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
     first = own_windows_.store(scratch_);
     count = static_cast<std::uint32_t>(scratch_.size());
   }
-  entity_windows_[entity] = first;
-  entity_count_[entity] = count;
+  entities_[entity] = EntityWindows{first, count, generation_};
   entity_ids_[entity] = window_ids_;
   window_ids_ += count;
 }
