@@ -35,7 +35,7 @@ void WindowSearch::begin(const SearchInput& input) {
     entities_.assign(entities, EntityWindows{});
     entity_ids_.assign(entities, 0);
   }
-  agent_slot_ = topology::TimelineSet::AgentBits::slot(input.agent);
+  agent_bits_ = topology::TimelineSet::AgentBits::key(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
@@ -61,7 +61,7 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   std::uint32_t count = 0;
   const topology::TimelineSet::NewcomerWindows& newcomer =
       input.timelines->newcomer_windows(entity);
-  if (input.count_locks && !newcomer.agents.may_contain(agent_slot_)) {
+  if (input.count_locks && !newcomer.agents.may_contain(agent_bits_)) {
     // Served in place, without those that end by the start time. The first may start
     // before it; the search never gets there before it, and every reader takes a window
     // start as "free from", so that start only weakens bounds.

@@ -278,7 +278,7 @@ class WindowSearch {
   // TimelineSet between changes); those of an exact query live here.
   WindowStore own_windows_;
   std::vector<topology::Interval> scratch_;  // an exact query's answer, before it is stored
-  std::uint8_t agent_slot_ = 0;   // TimelineSet::AgentBits::slot of the search's agent
+  topology::TimelineSet::AgentBits::Key agent_bits_;  // of the search's agent
   std::vector<State> states_;
   DivingMinHeap<OpenEntry> open_;
   /// The label of a state of prove_late's backward search: the latest time the vehicle may

@@ -400,7 +400,7 @@ class RandomRun {
     }
     EXPECT_EQ(newcomer, ref_.free_windows(entity, "newcomer", from, kForever));
     for (const Reservation& r : set_.timeline(entity).reservations) {
-      EXPECT_TRUE(view.agents.may_contain(TimelineSet::AgentBits::slot(r.agent))) << r.agent;
+      EXPECT_TRUE(view.agents.may_contain(TimelineSet::AgentBits::key(r.agent))) << r.agent;
     }
     for (std::size_t i = 0; i < got.size(); ++i) {  // sorted, disjoint, maximal, inside
       EXPECT_TRUE(got[i].valid());

@@ -90,7 +90,7 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
   newcomer.agents = AgentBits{};
   sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, newcomer.windows, true,
         [&newcomer](const Reservation& r) {
-          newcomer.agents.add(AgentBits::slot(r.agent));
+          newcomer.agents.add(AgentBits::key(r.agent));
           return false;
         });
 }
