@@ -110,28 +110,58 @@ HeuristicTable& HeuristicCache::table(const RoutingGraph& graph, std::uint64_t c
                                       EntityIndex goal) {
   for (Entry& entry : entries_) {
     if (entry.class_id == class_id && entry.table->root() == goal) {
+      entry.kept = entry.kept || entry.last_request != request_;  // a second request
       entry.last_request = request_;
       return *entry.table;
     }
   }
-  Entry* slot = nullptr;
-  if (entries_.size() >= capacity_) {
-    // Replace the least recently used table that this request does not hold.
-    for (Entry& entry : entries_) {
-      if (entry.last_request != request_ &&
-          (slot == nullptr || entry.last_request < slot->last_request)) {
-        slot = &entry;
-      }
-    }
-  }
+  const bool kept = recall(class_id, goal);
+  Entry* slot = entries_.size() < capacity_ ? nullptr : victim();
   if (slot == nullptr) {
-    entries_.push_back(Entry{std::make_unique<HeuristicTable>(), 0, 0});
+    entries_.push_back(Entry{std::make_unique<HeuristicTable>(), 0, 0, false});
     slot = &entries_.back();
+  } else if (!slot->kept) {
+    // Remember the pair replaced on probation, in a ring of capacity_ pairs.
+    const Pair pair{slot->class_id, slot->table->root()};
+    if (replaced_.size() < capacity_) {
+      replaced_.push_back(pair);
+    } else {
+      replaced_[replaced_next_] = pair;
+      replaced_next_ = (replaced_next_ + 1) % capacity_;
+    }
   }
   slot->class_id = class_id;
   slot->last_request = request_;
+  slot->kept = kept;
   slot->table->reset(graph, goal);
   return *slot->table;
+}
+
+HeuristicCache::Entry* HeuristicCache::victim() {
+  Entry* newest_on_probation = nullptr;
+  Entry* oldest_kept = nullptr;
+  for (Entry& entry : entries_) {
+    if (entry.last_request == request_) continue;  // held by this request
+    if (!entry.kept) {
+      if (newest_on_probation == nullptr ||
+          entry.last_request > newest_on_probation->last_request) {
+        newest_on_probation = &entry;
+      }
+    } else if (oldest_kept == nullptr || entry.last_request < oldest_kept->last_request) {
+      oldest_kept = &entry;
+    }
+  }
+  return newest_on_probation != nullptr ? newest_on_probation : oldest_kept;
+}
+
+bool HeuristicCache::recall(std::uint64_t class_id, EntityIndex goal) {
+  for (Pair& pair : replaced_) {
+    if (pair.class_id == class_id && pair.goal == goal) {
+      pair.goal = topology::kNoEntity;  // forgotten: back in the cache from now on
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace drover::carp

