@@ -88,8 +88,11 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
                                                   ? adjacency.sources_of(top)
                                                   : adjacency.targets_of(top);
     for (const EntityIndex v : next) {
-      // Without a branch (whether a vertex was found already follows no pattern): a vertex
-      // found already keeps its label, at its shortest, and the slot taken stays free.
+      // A vertex found already keeps its label, at its shortest, and the slot written stays
+      // free. The queue is written whatever; GCC 12 still branches around the label's store
+      // and the tail's step, which suits the warehouse's aisles, where the branch predicts
+      // well and lets the cache misses of later labels overlap (docs/benchmarks.md: a
+      // conditional move instead was faster on the random map, slower on the warehouse).
       const DurationNs old = label[v];
       const bool found = old != kUnreachable;
       label[v] = found ? old : ~through;

@@ -3,7 +3,6 @@
 // holds are never replaced during it.
 
 #include <memory>
-#include <vector>
 
 #include <gtest/gtest.h>
 
