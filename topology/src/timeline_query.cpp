@@ -79,6 +79,21 @@ void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, TimeNs
 void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                                       TimeNs until, std::vector<Interval>& out,
                                       bool count_locks) const {
+  // An agent with no reservation on the entity sees the newcomer's windows (kept up to date,
+  // locks counted), clipped to [from, until): the same answer as a sweep started at `from`
+  // (a holder starting by then only drops windows that end before it), without reading
+  // the reservations. A planner asks this for every start and goal it checks.
+  if (count_locks && owns(entity) && from < until) {
+    const NewcomerWindows& newcomer = newcomers_.of[entity];
+    if (!newcomer.agents.may_contain(AgentBits::key(agent))) {
+      for (const Interval& w : newcomer.windows) {
+        if (w.end <= from) continue;
+        if (w.start >= until) break;
+        out.push_back(Interval{std::max(w.start, from), std::min(w.end, until)});
+      }
+      return;
+    }
+  }
   Impl::sweep(*this, entity, from, until, out, count_locks,
               [agent](const Reservation& r) { return same_agent(r.agent, agent); });
 }
