@@ -3,11 +3,11 @@
 
 #include <functional>
 #include <set>
-
-#include <boost/container/flat_set.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <boost/container/flat_set.hpp>
 
 #include "drover/topology/timeline.hpp"
 
