@@ -156,6 +156,10 @@ struct Planner::Impl {
     if (options.quick_proof_after > 0 && options.quick_proof_budget == 0) {
       return invalid("the planner's quick_proof_budget must be >= 1 when quick_proof_after is set");
     }
+    if (options.shut_in_after > 0 && (options.shut_in_region == 0 || options.shut_in_budget == 0)) {
+      return invalid(fmt::format("the planner's {} must be >= 1 when shut_in_after is set",
+                                 options.shut_in_region == 0 ? "shut_in_region" : "shut_in_budget"));
+    }
     if (request.agent.empty()) return invalid("the agent id is empty");
     if (auto valid = validate(request.vehicle); !valid) return invalid(valid.error().message);
     if (timelines.entity_count() != topology().entity_count()) {
@@ -387,6 +391,9 @@ struct Planner::Impl {
     input.quick_proof_budget = options.quick_proof_budget;
     input.floor_proof_after = options.floor_proof_after;
     input.floor_proof_budget = options.floor_proof_budget;
+    input.shut_in_after = options.shut_in_after;
+    input.shut_in_region = options.shut_in_region;
+    input.shut_in_budget = options.shut_in_budget;
     const SearchOutcome outcome = search.run(input);
     stats = search.stats();
     if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));

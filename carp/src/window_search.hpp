@@ -51,6 +51,9 @@ struct SearchInput {
   std::size_t quick_proof_budget = PlannerOptions{}.quick_proof_budget;
   std::size_t floor_proof_after = PlannerOptions{}.floor_proof_after;
   std::size_t floor_proof_budget = PlannerOptions{}.floor_proof_budget;
+  std::size_t shut_in_after = PlannerOptions{}.shut_in_after;
+  std::size_t shut_in_region = PlannerOptions{}.shut_in_region;
+  std::size_t shut_in_budget = PlannerOptions{}.shut_in_budget;
 };
 
 struct SearchOutcome {
@@ -66,7 +69,8 @@ class WindowSearch {
   Route route(const SearchInput& input) const;
   /// What the last run() did.
   PlanStats stats() const {
-    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_, proof_routes_};
+    return PlanStats{arrival_floor_, floor_proofs_, floor_raises_, proof_routes_, expanded_,
+                     shut_in_proofs_, shut_in_refusals_};
   }
 
  private:
@@ -156,6 +160,16 @@ class WindowSearch {
   /// to the goal (then the earliest) whose label it reaches by: a label is the latest the
   /// vehicle may be ready there and still arrive by the deadline, so one always exists.
   void follow_labels(const SearchInput& input);
+  /// True when the last stop is shut in: the vertices from which it can be reached over
+  /// arcs whose edge and source vertex some time become free for good (their last window is
+  /// open-ended) are at most input.shut_in_region, the start not among them. Every route
+  /// then enters that region over an entity that is blocked for good from some time on.
+  /// Cheap (a bounded breadth-first search), so that the proof it calls for is tried only
+  /// where it may succeed.
+  bool last_stop_shut_in(const SearchInput& input);
+  /// Tries to prove that no route arrives within the horizon (prove_late with the
+  /// search's deadline). \return true when proven: the search can end without a route.
+  bool prove_no_route(const SearchInput& input, SearchOutcome& outcome);
   /// A lower bound of the reservation-free travel time from the start to `vertex`,
   /// kUnreachable if no route passes there: the earliest a route can be there after the
   /// start time. In a full proof the exact time, from a table set up by the first call of
@@ -320,6 +334,13 @@ class WindowSearch {
   std::size_t floor_proofs_ = 0;   // prove_late calls in this search
   std::size_t floor_raises_ = 0;   // of which proven
   std::size_t proof_routes_ = 0;   // 1 when a proof found the route
+  std::size_t expanded_ = 0;       // states expanded in this search
+  std::size_t shut_in_proofs_ = 0;    // see PlanStats
+  std::size_t shut_in_refusals_ = 0;
+  // last_stop_shut_in's breadth-first search: vertices stamped with the search's generation
+  // once queued, and the queue.
+  std::vector<std::uint32_t> region_stamp_;
+  std::vector<topology::EntityIndex> region_queue_;
   std::vector<State> path_;  // the route found, from the start state to the goal's
 };
 

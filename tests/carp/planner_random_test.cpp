@@ -187,7 +187,8 @@ Topology random_grid(std::mt19937& rng) {
 
 /// Fills the timelines with random reservations of agents b, c, d (and a few of a's own,
 /// which must not matter) and random locks; returns what blocks agent a.
-std::vector<Blocker> random_traffic(World& w, std::mt19937& rng) {
+/// `parked`: the chance that a reservation of the traffic is open-ended (an agent parked).
+std::vector<Blocker> random_traffic(World& w, std::mt19937& rng, double parked = 0.03) {
   std::uniform_real_distribution<double> coin(0, 1);
   std::uniform_int_distribution<EntityIndex> entity(
       0, static_cast<EntityIndex>(w.topology.entity_count() - 1));
@@ -198,7 +199,7 @@ std::vector<Blocker> random_traffic(World& w, std::mt19937& rng) {
     for (int i = 0; i < attempts; ++i) {
       const EntityIndex e = entity(rng);
       const int from = start(rng);
-      const int until = coin(rng) < 0.03 ? kNever : from + length(rng);
+      const int until = coin(rng) < parked ? kNever : from + length(rng);
       const topology::Interval window{sec(from), until == kNever ? kForever : sec(until)};
       if (w.timelines.reserve(agent, w.next_route++, {{e, window}}) && agent[0] != 'a') {
         blockers.push_back(Blocker{e, from, until});
@@ -246,6 +247,7 @@ PlanRequest random_request(const World& w, std::mt19937& rng, bool open_ended_on
 struct ProofUse {
   int raised = 0;  ///< trials in which a proof raised the floor
   int routes = 0;  ///< trials whose route a proof found (it reached the start)
+  int shut_in = 0;  ///< trials that a shut-in proof ended (no route)
 };
 
 /// Plans `trials` random requests on random small grids with random traffic and compares
@@ -253,9 +255,9 @@ struct ProofUse {
 /// (which must never pass the earliest arrival, whatever the search's luck in finding it).
 /// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
 /// proof budgets (1 to 32 states), so that proofs also give up and try again.
-/// `use`: what the proofs did, if asked.
+/// `use`: what the proofs did, if asked. `parked`: as for random_traffic.
 void check_against_brute_force(PlannerOptions options, int trials, bool open_ended_only = false,
-                               ProofUse* use = nullptr) {
+                               ProofUse* use = nullptr, double parked = 0.03) {
   const std::size_t budget = options.floor_proof_budget;
   const std::size_t quick_budget = options.quick_proof_budget;
   std::mt19937 rng(20240611);
@@ -267,7 +269,7 @@ void check_against_brute_force(PlannerOptions options, int trials, bool open_end
     options.floor_proof_budget = small ? 1 + trial / 4 % 32 : budget;
     options.quick_proof_budget = small ? 1 + trial / 4 % 32 : quick_budget;
     World w(random_grid(rng), options);
-    const std::vector<Blocker> blockers = random_traffic(w, rng);
+    const std::vector<Blocker> blockers = random_traffic(w, rng, parked);
     const PlanRequest request = random_request(w, rng, open_ended_only);
     const auto expected = BruteForce(w.topology, blockers, request).earliest_arrival();
     const auto planned = w.planner.plan(w.timelines, request);
@@ -275,6 +277,7 @@ void check_against_brute_force(PlannerOptions options, int trials, bool open_end
     if (use != nullptr) {
       use->raised += stats.floor_raises > 0 ? 1 : 0;
       use->routes += static_cast<int>(stats.proof_routes);
+      use->shut_in += static_cast<int>(stats.shut_in_refusals);
     }
     if (expected) {
       // A floor past the earliest arrival is a wrong proof even when the search happens to
@@ -341,6 +344,20 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) 
                             1200, true, &use);
   EXPECT_GT(use.raised, 150) << use.raised;
   EXPECT_GT(use.routes, 300) << use.routes;
+}
+
+// Shut-in proofs end a search with no route: here every search for one open-ended stop
+// checks after its first state whether the stop is shut in (in a region of any size), and
+// tries the proof with a budget no small grid exhausts, among agents parked for good half of
+// the time. A wrong proof would refuse a request the brute force routes.
+TEST(PlannerRandom, ShutInProofsRefuseOnlyRequestsWithoutARoute) {
+  ProofUse use;
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .shut_in_after = 1,
+                                           .shut_in_region = 1 << 20,
+                                           .shut_in_budget = 1 << 20},
+                            1200, true, &use, 0.5);
+  EXPECT_GT(use.shut_in, 40) << use.shut_in;
 }
 
 TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {

@@ -245,6 +245,44 @@ TEST(Planner, FailsWithoutASearchWhenNoEdgeIntoTheGoalIsEverFreeToStay) {
   EXPECT_LT(open.planner.last_stats().arrival_floor, kForever);
 }
 
+TEST(Planner, FailsAtOnceWhenTheGoalIsShutInBeforeAnyRouteCanGetThere) {
+  // b parks for good at 9,0 from 3 s on, shutting in the goal 11,0 (and 10,0) long before a,
+  // ten cells away, could get past: the shut-in proof ends the search after its first state
+  // (shut_in_after = 1 here; a real search would have tried every window it can reach).
+  // The outcome is the one without the proof, only sooner.
+  const auto shut_in = [](TimeNs parked_from, PlannerOptions options) {
+    auto w = std::make_unique<World>(GridBuilder().corridor(12).build(), options);
+    w->occupy("b", "9,0", parked_from, kForever);
+    return w;
+  };
+  const PlannerOptions proving{.shut_in_after = 1};
+  const PlannerOptions searching{.shut_in_after = 0};
+  auto w = shut_in(sec(3), proving);
+  const PlanError e = plan_error(*w, request_to(*w, "a", "0,0", {open_stop(*w, "11,0")}));
+  EXPECT_EQ(w->planner.last_stats().shut_in_proofs, 1u);
+  EXPECT_EQ(w->planner.last_stats().shut_in_refusals, 1u);
+  EXPECT_EQ(w->planner.last_stats().expanded, 1u);
+  auto s = shut_in(sec(3), searching);
+  const PlanError searched = plan_error(*s, request_to(*s, "a", "0,0", {open_stop(*s, "11,0")}));
+  EXPECT_EQ(s->planner.last_stats().shut_in_proofs, 0u);
+  EXPECT_GT(s->planner.last_stats().expanded, 1u);
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_EQ(e.reason, searched.reason);
+  EXPECT_EQ(e.message, searched.message);
+  EXPECT_EQ(e.blockers, std::vector<std::string>{"b"}) << e.message;
+  // Parked from 30 s on, b lets a in first: the region is shut in all the same, the proof
+  // fails, and the search finds the route it finds without it.
+  auto late = shut_in(sec(30), proving);
+  const Route route = plan_ok(*late, request_to(*late, "a", "0,0", {open_stop(*late, "11,0")}));
+  EXPECT_EQ(late->planner.last_stats().shut_in_proofs, 1u);
+  EXPECT_EQ(late->planner.last_stats().shut_in_refusals, 0u);
+  EXPECT_EQ(route.arrival, sec(11));
+  // The start inside the region: nothing is shut in, no proof is tried.
+  auto inside = shut_in(sec(3), proving);
+  plan_ok(*inside, request_to(*inside, "a", "10,0", {open_stop(*inside, "11,0")}));
+  EXPECT_EQ(inside->planner.last_stats().shut_in_proofs, 0u);
+}
+
 TEST(Planner, ReportsWhyTheStartIsNotFree) {
   World w(GridBuilder().corridor(3).build());
   w.occupy("b", "0,0", sec(0), sec(10));
@@ -376,6 +414,8 @@ TEST(Planner, RejectsInvalidOptions) {
       {PlannerOptions{.floor_proof_after = 0}, "floor_proof_after"},
       {PlannerOptions{.floor_proof_budget = 0}, "floor_proof_budget"},
       {PlannerOptions{.quick_proof_after = 8, .quick_proof_budget = 0}, "quick_proof_budget"},
+      {PlannerOptions{.shut_in_region = 0}, "shut_in_region"},
+      {PlannerOptions{.shut_in_budget = 0}, "shut_in_budget"},
   };
   for (const auto& [options, named] : cases) {
     SCOPED_TRACE(named);
@@ -389,6 +429,11 @@ TEST(Planner, RejectsInvalidOptions) {
   World w(GridBuilder().corridor(3).build(),
           PlannerOptions{.quick_proof_after = 0, .quick_proof_budget = 0});
   EXPECT_TRUE(w.planner.plan(w.timelines, request_to(w, "a", "0,0", {open_stop(w, "2,0")})));
+  // Nor do no shut-in checks.
+  World unchecked(GridBuilder().corridor(3).build(),
+                  PlannerOptions{.shut_in_after = 0, .shut_in_region = 0, .shut_in_budget = 0});
+  EXPECT_TRUE(unchecked.planner.plan(unchecked.timelines,
+                                     request_to(unchecked, "a", "0,0", {open_stop(unchecked, "2,0")})));
 }
 
 TEST(Planner, ATestRouteReservesNothing) {

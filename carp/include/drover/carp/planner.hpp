@@ -34,6 +34,16 @@ struct PlannerOptions {
   /// at each further try. Any value >= 1 gives the same arrivals; 128 paid off best (64,
   /// 192, 256, 512, 1024 tried).
   std::size_t floor_proof_budget = 128;
+  /// After expanding this many states, a search for one open-ended stop checks whether
+  /// the stop is shut in: whether the entities that some time become free for good
+  /// connect it with at most shut_in_region vertices, the start not among them (agents
+  /// parked around it for good). If so, it tries to prove, with at most shut_in_budget
+  /// backward states, that no route arrives at all, and fails at once if that holds
+  /// (warehouse N = 400: two such searches expanded 10 000 states each before). Once per
+  /// search; 0: never. Any values give the same outcomes (docs/carp.md).
+  std::size_t shut_in_after = 256;
+  std::size_t shut_in_region = 16;
+  std::size_t shut_in_budget = 4096;
 };
 
 /// What the search of the last Planner::plan call did (for tests and measurements).
@@ -44,6 +54,11 @@ struct PlanStats {
   std::size_t floor_proofs = 0;  ///< backward proofs tried
   std::size_t floor_raises = 0;  ///< proofs that raised the floor
   std::size_t proof_routes = 0;  ///< 1 when a proof found the route (it reached the start)
+  std::size_t expanded = 0;      ///< states taken from the open list (stale entries aside)
+  /// 1 when the search found its last stop shut in (see PlannerOptions::shut_in_after) and
+  /// tried to prove that no route arrives at all.
+  std::size_t shut_in_proofs = 0;
+  std::size_t shut_in_refusals = 0;  ///< 1 when that proof held and ended the search
 };
 
 /// The route planner of a routing agent. It keeps search memory and heuristic tables
