@@ -54,7 +54,11 @@ void TimelineSet::Impl::bump_versions(TimelineSet& set, const TouchedSet& touche
   const std::uint64_t revision = next_revision();
   for (EntityIndex entity : touched) {
     ++set.timelines_[entity].version;
-    if (windows == Windows::changed) revise(set, entity, revision);
+    if (windows == Windows::changed) {
+      revise(set, entity, revision);
+    } else if (windows == Windows::updated) {
+      set.revisions_.of[entity] = revision;
+    }
   }
 }
 

@@ -22,11 +22,12 @@ struct TimelineSet::Impl {
   /// Timeline order (see Timeline::reservations).
   static bool timeline_order(const Reservation& a, const Reservation& b);
   static void sort_reservations(Timeline& timeline);
-  /// Whether a change of timelines changed what their free windows read.
-  enum class Windows { changed, unchanged };
+  /// Whether a change of timelines changed what their free windows read, and whether the
+  /// change kept them up to date itself (`updated`: only their revision must move).
+  enum class Windows { changed, updated, unchanged };
   /// Increments the version of every touched entity and, unless `windows` is unchanged,
-  /// revises its free windows (a change of reservations changes only the windows of the
-  /// timelines it touches).
+  /// moves its windows revision, revising its free windows when they `changed` (a change of
+  /// reservations changes only the windows of the timelines it touches).
   static void bump_versions(TimelineSet& set, const TouchedSet& touched,
                             Windows windows = Windows::changed);
   /// A revision number never used before in this process.
@@ -41,6 +42,14 @@ struct TimelineSet::Impl {
   static void revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision);
   /// Revises every entity, with one fresh revision (a set made or restored).
   static void revise_all(TimelineSet& set);
+  /// Removes `cut` from the windows out[base..] (sorted, disjoint), splitting one if needed.
+  static void cut_window(std::vector<Interval>& out, std::size_t base, Interval cut);
+  /// Whether admit would accept `item` on its timeline without reading the reservations:
+  /// its agent has none there (`agent` is its AgentBits key) and its window lies within one
+  /// of the newcomer's windows, which every reservation, holder and lock there (and the
+  /// locks on the conflict set) keep clear. False says nothing.
+  static bool clear_for_newcomer(const TimelineSet& set, const Reservation& item,
+                                 AgentBits::Key agent);
   /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.
   template <class Skip>
   static void sweep(const TimelineSet& set, EntityIndex entity, TimeNs from, TimeNs until,
@@ -65,7 +74,8 @@ struct TimelineSet::Impl {
   /// Every check of prepare (see its contract), for `op` ("prepare" or "reserve").
   static Status admit(const TimelineSet& set, const std::vector<Reservation>& items,
                       const std::vector<ExpectedVersion>& expected, const std::string& op);
-  /// Adds admitted items to their timelines, prepared or committed; records where.
+  /// Adds admitted items to their timelines, prepared or committed; records where, and
+  /// keeps their free windows up to date (bump_versions with Windows::updated after it).
   static void insert(TimelineSet& set, const std::vector<Reservation>& items, bool prepared,
                      TouchedSet& touched);
 

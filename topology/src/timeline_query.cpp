@@ -27,8 +27,9 @@ bool same_agent(const std::string& a, std::string_view b) {
   return a.size() == b.size() && (b.empty() || a.back() == b.back()) && a == b;
 }
 
-/// Removes `cut` from the windows out[base..] (sorted, disjoint), splitting one if needed.
-void cut_from(std::vector<Interval>& out, std::size_t base, Interval cut) {
+}  // namespace
+
+void TimelineSet::Impl::cut_window(std::vector<Interval>& out, std::size_t base, Interval cut) {
   const auto begin = out.begin() + static_cast<std::ptrdiff_t>(base);
   const auto first =
       std::partition_point(begin, out.end(), [&](const Interval& w) { return w.end <= cut.start; });
@@ -42,7 +43,16 @@ void cut_from(std::vector<Interval>& out, std::size_t base, Interval cut) {
   if (left.valid()) out.insert(at, left);
 }
 
-}  // namespace
+bool TimelineSet::Impl::clear_for_newcomer(const TimelineSet& set, const Reservation& item,
+                                           AgentBits::Key agent) {
+  const NewcomerWindows& newcomer = set.newcomers_.of[item.entity];
+  if (newcomer.agents.may_contain(agent)) return false;
+  const auto window = std::partition_point(
+      newcomer.windows.begin(), newcomer.windows.end(),
+      [&](const Interval& w) { return w.end <= item.window.start; });
+  return window != newcomer.windows.end() && window->start <= item.window.start &&
+         item.window.end <= window->end;
+}
 
 template <class Skip>
 void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, TimeNs from,
@@ -67,7 +77,7 @@ void TimelineSet::Impl::sweep(const TimelineSet& set, EntityIndex entity, TimeNs
   if (cursor < until) out.push_back(Interval{cursor, until});
   if (count_locks && set.lock_count_ > 0) {
     const auto cut_locks = [&](EntityIndex x) {
-      for (const Lock& lock : set.timelines_[x].locks) cut_from(out, base, lock.window);
+      for (const Lock& lock : set.timelines_[x].locks) cut_window(out, base, lock.window);
     };
     cut_locks(entity);
     for (EntityIndex f : set.conflict_sets_[entity]) {
