@@ -170,6 +170,10 @@ Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reserv
 
 void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>& items,
                                bool prepared, TouchedSet& touched) {
+  // Recorded at once at the end: one by one into the sorted set, the hundreds of entities
+  // of a route cost reserve 2 % more instructions.
+  std::vector<EntityIndex> entities;
+  entities.reserve(items.size());
   for (const Reservation& item : items) {
     // Each item goes where timeline order puts it (a route adds one or a few items to a
     // timeline of many: cheaper than sorting the timeline again).
@@ -177,7 +181,7 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
     const auto at = std::upper_bound(timeline.begin(), timeline.end(), item, timeline_order);
     Reservation& added = *timeline.insert(at, item);
     added.prepared = prepared;
-    touched.insert(item.entity);
+    entities.push_back(item.entity);
     // The newcomer's windows lose the item's window, and its agent is among those with a
     // reservation there: what revise's sweep would find, without reading the reservations
     // again. Unless the item is held (never, after admit: its step would be reserved here
@@ -190,6 +194,7 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
       cut_window(newcomer.windows, 0, item.window);
     }
   }
+  touched.insert(entities.begin(), entities.end());
 }
 
 Result<PrepareId> TimelineSet::prepare(const std::vector<Reservation>& items,
