@@ -177,7 +177,7 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
 
 WindowSearch::FloorProof WindowSearch::raise_arrival_floor(const SearchInput& input,
                                                            ProofKind kind) {
-  if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return FloorProof::go_on;
+  if (!backward_proofs_apply(input)) return FloorProof::go_on;
   const TimeNs floor = arrival_floor_;
   const std::size_t budget = kind == ProofKind::quick ? input.quick_proof_budget : proof_budget_;
   for (int round = 0; round < kLateProofRounds; ++round) {
@@ -360,7 +360,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
 }
 
 bool WindowSearch::last_stop_shut_in(const SearchInput& input) {
-  if (input.legs.size() != 1 || input.legs.back().dwell != kForever) return false;
+  if (!backward_proofs_apply(input)) return false;
   const RoutingGraph& graph = *input.graph;
   const auto free_for_good = [&](EntityIndex entity) {
     std::uint32_t count = 0;

@@ -132,6 +132,11 @@ class WindowSearch {
     no_route,     ///< no route ever arrives (a certificate of failure)
     route_found,  ///< a route arrives at the floor, the earliest possible: it is in path_
   };
+  /// Whether prove_late applies: one stop, held open-ended (the proofs search back from its
+  /// open-ended window).
+  static bool backward_proofs_apply(const SearchInput& input) {
+    return input.legs.size() == 1 && input.legs.back().dwell == kForever;
+  }
   /// Raises arrival_floor_ while prove_late proves that no route arrives by it, and re-keys
   /// the open list. Only for one open-ended stop. Called once a search has expanded many
   /// states keyed by the floor: all that could arrive by the floor share it as key, and with
@@ -334,7 +339,7 @@ class WindowSearch {
   std::size_t floor_proofs_ = 0;   // prove_late calls in this search
   std::size_t floor_raises_ = 0;   // of which proven
   std::size_t proof_routes_ = 0;   // 1 when a proof found the route
-  std::size_t expanded_ = 0;       // states expanded in this search
+  std::size_t expanded_ = 0;       // see PlanStats
   std::size_t shut_in_proofs_ = 0;    // see PlanStats
   std::size_t shut_in_refusals_ = 0;
   // last_stop_shut_in's breadth-first search: vertices stamped with the search's generation
