@@ -92,7 +92,7 @@ void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, st
                             std::vector<std::string>& holders) {
   if (!timelines.owns(entity)) return;
   // Nobody holds it open-ended when a newcomer can have it for good: most entities.
-  const std::vector<Interval>& free = timelines.newcomer_windows(entity).windows;
+  const std::span<const Interval> free = timelines.newcomer_windows(entity).windows();
   if (!free.empty() && free.back().end == kForever) return;
   for (const topology::Reservation& r : timelines.timeline(entity).reservations) {
     // The window first: most reservations end, and comparing it is cheaper than the agent.

@@ -65,12 +65,12 @@ void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
   std::uint32_t count = 0;
   const topology::TimelineSet::NewcomerWindows& newcomer =
       input.timelines->newcomer_windows(entity);
-  if (input.count_locks && !newcomer.agents.may_contain(agent_bits_)) {
+  if (input.count_locks && !newcomer.agents().may_contain(agent_bits_)) {
     // Served in place, without those that end by the start time. The first may start
     // before it; the search never gets there before it, and every reader takes a window
     // start as "free from", so that start only weakens bounds.
-    first = newcomer.windows.data();
-    count = static_cast<std::uint32_t>(newcomer.windows.size());
+    first = newcomer.windows().data();
+    count = static_cast<std::uint32_t>(newcomer.windows().size());
     const std::uint32_t past = ending_after(first, count, input.start_time);
     first += past;
     count -= past;

@@ -395,12 +395,12 @@ class RandomRun {
     // and the agents said to have reservations there: all of them.
     const auto view = set_.newcomer_windows(entity);
     std::vector<Interval> newcomer;  // the view from `from` on, as a planner reads it
-    for (const Interval& w : view.windows) {
+    for (const Interval& w : view.windows()) {
       if (w.end > from) newcomer.push_back(Interval{std::max(w.start, from), w.end});
     }
     EXPECT_EQ(newcomer, ref_.free_windows(entity, "newcomer", from, kForever));
     for (const Reservation& r : set_.timeline(entity).reservations) {
-      EXPECT_TRUE(view.agents.may_contain(TimelineSet::AgentBits::key(r.agent))) << r.agent;
+      EXPECT_TRUE(view.agents().may_contain(TimelineSet::AgentBits::key(r.agent))) << r.agent;
     }
     for (std::size_t i = 0; i < got.size(); ++i) {  // sorted, disjoint, maximal, inside
       EXPECT_TRUE(got[i].valid());

@@ -369,18 +369,18 @@ TEST_F(TimelineTest, NewcomerWindowsAreThoseOfAnAgentWithoutReservationsThere) {
   const auto view = set.newcomer_windows(0);
   // From the beginning of time: what a newcomer finds from 5 on are the windows ending
   // after 5, the first from 5.
-  ASSERT_EQ(view.windows.size(), 3u);
-  EXPECT_EQ(view.windows[0].end, 10);
-  EXPECT_LT(view.windows[0].start, 0);
-  EXPECT_EQ(std::vector<Interval>(view.windows.begin() + 1, view.windows.end()),
+  ASSERT_EQ(view.windows().size(), 3u);
+  EXPECT_EQ(view.windows()[0].end, 10);
+  EXPECT_LT(view.windows()[0].start, 0);
+  EXPECT_EQ(std::vector<Interval>(view.windows().begin() + 1, view.windows().end()),
             (std::vector<Interval>{{20, 30}, {40, kForever}}));
   EXPECT_EQ(set.free_windows(0, "bob", 5, kForever),
             (std::vector<Interval>{{5, 10}, {20, 30}, {40, kForever}}));
   TimelineSet::AgentBits amy;
   amy.add(TimelineSet::AgentBits::key("amy"));
-  EXPECT_EQ(view.agents, amy);
-  EXPECT_TRUE(view.agents.may_contain(TimelineSet::AgentBits::key("amy")));
-  EXPECT_TRUE(set.newcomer_windows(99).windows.empty());  // not an entity of the set
+  EXPECT_EQ(view.agents(), amy);
+  EXPECT_TRUE(view.agents().may_contain(TimelineSet::AgentBits::key("amy")));
+  EXPECT_TRUE(set.newcomer_windows(99).windows().empty());  // not an entity of the set
 }
 
 TEST(AgentBits, FleetIdsSpreadOverTheBits) {

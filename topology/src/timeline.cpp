@@ -113,7 +113,7 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
       revisions_{std::vector<std::uint64_t>(conflict_sets_.size())},
-      newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size())} {
+      newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size()), {}} {
   Impl::revise_all(*this);
 }
 

@@ -44,6 +44,8 @@ struct TimelineSet::Impl {
   static void revise_all(TimelineSet& set);
   /// Removes `cut` from the windows out[base..] (sorted, disjoint), splitting one if needed.
   static void cut_window(std::vector<Interval>& out, std::size_t base, Interval cut);
+  /// The same on a newcomer's windows.
+  static void cut_window(NewcomerWindows& windows, Interval cut);
   /// Whether admit would accept `item` on its timeline without reading the reservations:
   /// its agent has none there (`agent` is its AgentBits key) and its window lies within one
   /// of the newcomer's windows, which every reservation, holder and lock there (and the

@@ -190,8 +190,8 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
       revise(set, item.entity, set.revisions_.of[item.entity]);
     } else {
       NewcomerWindows& newcomer = set.newcomers_.of[item.entity];
-      newcomer.agents.add(AgentBits::key(item.agent));
-      cut_window(newcomer.windows, 0, item.window);
+      newcomer.add_agent(AgentBits::key(item.agent));
+      cut_window(newcomer, item.window);
     }
   }
   touched.insert(entities.begin(), entities.end());

@@ -12,7 +12,9 @@
 // enough"). A held (allocated) reservation blocks from `from` on: nobody comes before it.
 
 #include <algorithm>
+#include <array>
 #include <limits>
+#include <span>
 
 #include "drover/topology/timeline.hpp"
 #include "timeline_impl.hpp"
@@ -29,28 +31,55 @@ bool same_agent(const std::string& a, std::string_view b) {
 
 }  // namespace
 
-void TimelineSet::Impl::cut_window(std::vector<Interval>& out, std::size_t base, Interval cut) {
-  const auto begin = out.begin() + static_cast<std::ptrdiff_t>(base);
-  const auto first =
-      std::partition_point(begin, out.end(), [&](const Interval& w) { return w.end <= cut.start; });
-  const auto last =
-      std::partition_point(first, out.end(), [&](const Interval& w) { return w.start < cut.end; });
-  if (first == last) return;
+namespace {
+
+/// What cutting an interval out of sorted, disjoint windows changes: the windows
+/// [first, last) overlap it, and what is left of them is pieces[0, count), in order.
+struct WindowCut {
+  std::size_t first = 0, last = 0;
+  std::array<Interval, 2> pieces{};
+  std::size_t count = 0;
+};
+
+WindowCut plan_cut(std::span<const Interval> windows, Interval cut) {
+  const auto first = std::partition_point(windows.begin(), windows.end(),
+                                          [&](const Interval& w) { return w.end <= cut.start; });
+  const auto last = std::partition_point(first, windows.end(),
+                                         [&](const Interval& w) { return w.start < cut.end; });
+  WindowCut plan{static_cast<std::size_t>(first - windows.begin()),
+                 static_cast<std::size_t>(last - windows.begin())};
+  if (first == last) return plan;
   const Interval left{first->start, cut.start};
   const Interval right{cut.end, (last - 1)->end};
-  auto at = out.erase(first, last);
-  if (right.valid()) at = out.insert(at, right);
-  if (left.valid()) out.insert(at, left);
+  if (left.valid()) plan.pieces[plan.count++] = left;
+  if (right.valid()) plan.pieces[plan.count++] = right;
+  return plan;
+}
+
+}  // namespace
+
+void TimelineSet::Impl::cut_window(std::vector<Interval>& out, std::size_t base, Interval cut) {
+  const WindowCut plan = plan_cut(std::span(out).subspan(base), cut);
+  if (plan.first == plan.last) return;
+  const auto at = out.erase(out.begin() + static_cast<std::ptrdiff_t>(base + plan.first),
+                            out.begin() + static_cast<std::ptrdiff_t>(base + plan.last));
+  out.insert(at, plan.pieces.begin(), plan.pieces.begin() + static_cast<std::ptrdiff_t>(plan.count));
+}
+
+void TimelineSet::Impl::cut_window(NewcomerWindows& windows, Interval cut) {
+  const WindowCut plan = plan_cut(windows.windows(), cut);
+  if (plan.first == plan.last) return;
+  windows.replace(plan.first, plan.last, std::span(plan.pieces).first(plan.count));
 }
 
 bool TimelineSet::Impl::clear_for_newcomer(const TimelineSet& set, const Reservation& item,
                                            AgentBits::Key agent) {
   const NewcomerWindows& newcomer = set.newcomers_.of[item.entity];
-  if (newcomer.agents.may_contain(agent)) return false;
+  if (newcomer.agents().may_contain(agent)) return false;
+  const std::span<const Interval> windows = newcomer.windows();
   const auto window = std::partition_point(
-      newcomer.windows.begin(), newcomer.windows.end(),
-      [&](const Interval& w) { return w.end <= item.window.start; });
-  return window != newcomer.windows.end() && window->start <= item.window.start &&
+      windows.begin(), windows.end(), [&](const Interval& w) { return w.end <= item.window.start; });
+  return window != windows.end() && window->start <= item.window.start &&
          item.window.end <= window->end;
 }
 
@@ -95,8 +124,8 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
   // the reservations. A planner asks this for every start and goal it checks.
   if (count_locks && owns(entity) && from < until) {
     const NewcomerWindows& newcomer = newcomers_.of[entity];
-    if (!newcomer.agents.may_contain(AgentBits::key(agent))) {
-      for (const Interval& w : newcomer.windows) {
+    if (!newcomer.agents().may_contain(AgentBits::key(agent))) {
+      for (const Interval& w : newcomer.windows()) {
         if (w.end <= from) continue;
         if (w.start >= until) break;
         out.push_back(Interval{std::max(w.start, from), std::min(w.end, until)});
@@ -111,13 +140,15 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
 void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64_t revision) {
   set.revisions_.of[entity] = revision;
   NewcomerWindows& newcomer = set.newcomers_.of[entity];
-  newcomer.windows.clear();
-  newcomer.agents = AgentBits{};
-  sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, newcomer.windows, true,
+  std::vector<Interval>& windows = set.newcomers_.scratch;
+  windows.clear();
+  newcomer.clear();
+  sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, windows, true,
         [&newcomer](const Reservation& r) {
-          newcomer.agents.add(AgentBits::key(r.agent));
+          newcomer.add_agent(AgentBits::key(r.agent));
           return false;
         });
+  newcomer.assign(windows);
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

@@ -29,6 +29,7 @@
 #include <cstring>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -191,6 +192,8 @@ struct TimelineSnapshot {
 
 /// The timelines of a set of entities (all of a topology, or one partition's).
 class TimelineSet {
+  struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
+
  public:
   /// \param conflict_sets  C(e) for every entity index (Topology::conflict_sets()); must be
   ///                       symmetric. Out-of-range indices and e itself are ignored.
@@ -289,9 +292,54 @@ class TimelineSet {
   /// out) appends those that end after `from`, the first starting at `from` at the
   /// earliest. And the agents with a reservation there: for an agent not in it, these are
   /// its windows.
-  struct NewcomerWindows {
-    std::vector<Interval> windows;
-    AgentBits agents;
+  ///
+  /// Laid out for a planner, which reads them for every entity it touches, mostly missing
+  /// the cache: the agents and the windows of an entity share one block, aligned to a cache
+  /// line, the agents first and the first two windows on the same line (bench plan,
+  /// random-32-32-20: half the entities have at most three windows). Only a pointer and the
+  /// count live in the set's array, which stays in cache. Changed by the set only.
+  class NewcomerWindows {
+   public:
+    NewcomerWindows() noexcept = default;
+    NewcomerWindows(const NewcomerWindows& other);
+    NewcomerWindows(NewcomerWindows&& other) noexcept { swap(other); }
+    NewcomerWindows& operator=(NewcomerWindows other) noexcept {
+      swap(other);
+      return *this;
+    }
+    ~NewcomerWindows();
+
+    /// The agents with a reservation on the entity (see AgentBits).
+    const AgentBits& agents() const noexcept { return *block_; }
+    /// The windows, sorted and disjoint, the first starting before any time asked for.
+    std::span<const Interval> windows() const noexcept { return {first(), size_}; }
+
+   private:
+    friend struct TimelineSet::Impl;
+    static constexpr std::size_t kLine = 64;
+    /// The windows follow the agents in the block.
+    Interval* first() const noexcept { return reinterpret_cast<Interval*>(block_ + 1); }
+    void swap(NewcomerWindows& other) noexcept {
+      std::swap(block_, other.block_);
+      std::swap(size_, other.size_);
+      std::swap(capacity_, other.capacity_);
+    }
+    /// No windows, no agents.
+    void clear() noexcept;
+    void add_agent(AgentBits::Key key);
+    void assign(std::span<const Interval> windows);
+    /// Replaces windows [first, last) by `pieces`.
+    void replace(std::size_t first, std::size_t last, std::span<const Interval> pieces);
+    /// Makes room for `capacity` windows, keeping the agents and windows; the block is
+    /// the set's own after (never the shared empty one).
+    void reserve(std::size_t capacity);
+
+    // The block: the agents, then capacity_ windows; while capacity_ is 0, a shared empty
+    // block that is never written.
+    AgentBits* block_ = const_cast<AgentBits*>(&kNoAgents);
+    std::uint32_t size_ = 0;
+    std::uint32_t capacity_ = 0;
+    alignas(kLine) static const AgentBits kNoAgents;
   };
   /// \return those of `entity`, kept by the set (recomputed whenever the entity's windows
   ///         revision moves): valid until the set changes. Empty for an entity not owned.
@@ -447,8 +495,6 @@ class TimelineSet {
                                      std::vector<bool> owned, const TimelineSnapshot& snapshot);
 
  private:
-  struct Impl;  // the helpers shared by the timeline sources (src/timeline_impl.hpp)
-
   /// Names one reservation of the set within a prepared set's (agent, route). Prepared
   /// sets remember keys, not copies, because a delay may move held items before commit.
   struct ItemKey {
@@ -487,6 +533,7 @@ class TimelineSet {
   // differ in it.
   struct Newcomers {
     std::vector<NewcomerWindows> of;
+    std::vector<Interval> scratch;  // a sweep's windows, before they are stored
     friend bool operator==(const Newcomers&, const Newcomers&) { return true; }
   };
   Newcomers newcomers_;
