@@ -1,7 +1,7 @@
 #include "bench/bench_plan.hpp"
 
 #include <algorithm>
-#include <ctime>
+#include <chrono>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -50,18 +50,21 @@ struct Outcome {
 
 struct CarpRun {
   std::vector<Outcome> outcomes;
-  double plan_seconds = 0;     ///< CPU time in the planner (search and route)
-  double reserve_seconds = 0;  ///< CPU time in TimelineSet::reserve (writing the routes)
+  double plan_seconds = 0;     ///< time in the planner (search and route)
+  double reserve_seconds = 0;  ///< time in TimelineSet::reserve (writing the routes)
 };
 
 constexpr topology::RouteId kRoute = 1;
 
-/// CPU time of the calling thread, in seconds. Unlike wall-clock time it does not count
-/// the time other processes on a busy machine take from us, so runs compare.
-double thread_seconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + static_cast<double>(now.tv_nsec) * 1e-9;
+/// A monotonic clock, in seconds. Read around every plan, so it must cost next to nothing
+/// and leave the caches alone: the thread's CPU clock (CLOCK_THREAD_CPUTIME_ID) is a system
+/// call on virtualised hosts (1.4 us on the development machine, with the TLB flushed on the
+/// way in and out), which every plan paid and the A* run, timed once, did not. This one is
+/// read in user space (vDSO, 27 ns there). Wall time counts what other processes take from
+/// the thread: the medians over --repeat runs leave such runs out.
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 carp::VehicleProfile bench_vehicle(double cell_size) {
@@ -74,17 +77,21 @@ carp::VehicleProfile bench_vehicle(double cell_size) {
   return vehicle;
 }
 
-/// Plain reservation-free A* for every agent. \return the CPU seconds it took.
+/// Plain reservation-free A* for every agent. \return the seconds it took.
 double run_astar(const std::shared_ptr<const carp::RoutingGraph>& graph,
                  const std::vector<Agent>& agents, const carp::VehicleProfile& vehicle,
                  std::size_t& found) {
   carp::FreePathSearch search(graph);
   found = 0;
-  const double start = thread_seconds();
+  double seconds = 0;
   for (const Agent& agent : agents) {
-    if (search.find(vehicle, agent.start, agent.goal)) ++found;
+    // Timed one by one, as the plans are, so that both pay the same for the clock.
+    const double start = now_seconds();
+    const bool path = search.find(vehicle, agent.start, agent.goal).has_value();
+    seconds += now_seconds() - start;
+    if (path) ++found;
   }
-  return thread_seconds() - start;
+  return seconds;
 }
 
 /// Prioritized planning with CARP, in scenario order: each agent gets a real route from
@@ -104,16 +111,16 @@ CarpRun run_carp(const std::shared_ptr<const carp::RoutingGraph>& graph,
     request.start = agents[i].start;
     request.start_time = 0;
     request.stops = {carp::Stop{agents[i].goal, std::nullopt}};
-    double start = thread_seconds();
+    double start = now_seconds();
     auto planned = planner.plan(timelines, request);
-    run.plan_seconds += thread_seconds() - start;
+    run.plan_seconds += now_seconds() - start;
     if (!planned) {
       run.outcomes[i].error = std::move(planned).error();
       continue;
     }
-    start = thread_seconds();
+    start = now_seconds();
     auto reserved = timelines.reserve(request.agent, kRoute, planned->steps);
-    run.reserve_seconds += thread_seconds() - start;
+    run.reserve_seconds += now_seconds() - start;
     if (!reserved) {
       throw std::runtime_error("the timelines refused the planned route of " + request.agent +
                                ": " + reserved.error().message);
