@@ -65,13 +65,6 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
 // vertex queued once, and only the vertex ids of the arcs read.
 namespace {
 
-/// Label tables up to this size take the breadth-first loop without a branch: a third of a
-/// small L1 data cache (32 KiB), so that the labels stay there. Bench plan on
-/// random-32-32-20 (819 vertices, 6.5 KiB of labels), ten alternating runs: ratio to A*
-/// 3.52 -> 3.36 at N = 200, 3.51 -> 3.18 at N = 400. warehouse-10-20-10-2-1 (5 699
-/// vertices, 45 KiB) keeps the branch, which was faster there without one.
-constexpr std::size_t kBranchlessLabelBytes = 12 * 1024;
-
 /// stored = old unless old is kUnreachable, by a conditional move: GCC 12 makes a branch
 /// of every way of writing this in C++ but mask arithmetic (more instructions).
 [[gnu::always_inline]] inline void keep_if_found(DurationNs& stored, DurationNs old) {
@@ -104,7 +97,7 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
   DurationNs* const label = label_.data();
   // In locals: the label stores could alias the members (same type, but for the sign).
   std::size_t head = fifo_head_, tail = fifo_tail_;
-  const bool small = graph.vertex_count() * sizeof(DurationNs) <= kBranchlessLabelBytes;
+  const bool small = graph.vertex_count() * sizeof(DurationNs) <= kBranchlessBytes;
   while (label[vertex] >= 0 && head < tail) {
     const EntityIndex top = queue[head++];
     const DurationNs through = ~label[top] + unit;

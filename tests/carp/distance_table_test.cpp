@@ -19,11 +19,13 @@
 namespace drover::carp::test {
 namespace {
 
-/// `uniform`: every edge 1 m long at 1 m/s, so every arc takes one second.
-topology::Topology random_grid(std::mt19937& rng, bool uniform) {
+/// `uniform`: every edge 1 m long at 1 m/s, so every arc takes one second. Sides of
+/// `min_side` to `max_side` cells.
+topology::Topology random_grid(std::mt19937& rng, bool uniform, int min_side = 2,
+                               int max_side = 8) {
   std::uniform_real_distribution<double> coin(0, 1), length(0.3, 4.0);
-  const int width = std::uniform_int_distribution<int>(2, 8)(rng);
-  const int height = std::uniform_int_distribution<int>(2, 8)(rng);
+  const int width = std::uniform_int_distribution<int>(min_side, max_side)(rng);
+  const int height = std::uniform_int_distribution<int>(min_side, max_side)(rng);
   GridBuilder g;
   const auto maybe_forbidden = [&] {
     topology::Restrictions restrictions;
@@ -103,6 +105,32 @@ TEST(DistanceTable, GivesTheFastestTravelTimeBetweenTheRootAndEveryVertex) {
     }
   }
   EXPECT_GT(compared, 3000);
+}
+
+// Breadth-first tables too large for L1 take a loop of their own (with a branch): the same
+// distances there, asked in random order, the search resumed and reset.
+TEST(DistanceTable, GivesTheFastestTravelTimesOnLargeUniformGridsToo) {
+  std::mt19937 rng(12);
+  const VehicleProfile vehicle = unit_vehicle();
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto topology = random_grid(rng, true, 45, 50);
+    const auto graph = std::make_shared<RoutingGraph>(topology);
+    ASSERT_GT(graph->vertex_count() * sizeof(DurationNs), HeuristicTable::kBranchlessBytes);
+    const Traversal traversal(*graph, vehicle);
+    FreePathSearch reference(graph);
+    HeuristicTable table;
+    for (int root_trial = 0; root_trial < 2; ++root_trial) {
+      auto root = static_cast<topology::EntityIndex>(rng() % graph->vertex_count());
+      while (!traversal.usable_vertex(root)) root = (root + 1) % graph->vertex_count();
+      table.reset(*graph, root);
+      for (int k = 0; k < 150; ++k) {
+        const auto v = static_cast<topology::EntityIndex>(rng() % graph->vertex_count());
+        const auto path = reference.find(vehicle, v, root);
+        ASSERT_EQ(table.distance(*graph, traversal, v), path ? path->travel_time : kUnreachable)
+            << "trial " << trial << ": " << topology.id(v) << " to " << topology.id(root);
+      }
+    }
+  }
 }
 
 }  // namespace
