@@ -606,7 +606,18 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
               kNone, 0, next_estimate);
     }
   }
-  for (const Traversal::Move& move : input.traversal->adjacency(*input.graph).out_of(vertex)) {
+  const auto moves = input.traversal->adjacency(*input.graph).out_of(vertex);
+  // The windows of the moves' edges and destinations, a cache miss each when the search
+  // first reads them (after a reserve, most are): asked for all at once, so that their
+  // misses overlap instead of coming one after another in drive (in-process A/B over 30
+  // repeats: ratio to A* -3 % at random N = 200, -4 % at N = 400, -10 % at warehouse
+  // N = 400). Reading the timelines' per-entity pointer costs no miss: neighbours' entries
+  // share lines.
+  for (const Traversal::Move& move : moves) {
+    __builtin_prefetch(input.timelines->newcomer_windows(move.edge).windows().data());
+    __builtin_prefetch(input.timelines->newcomer_windows(move.to).windows().data());
+  }
+  for (const Traversal::Move& move : moves) {
     drive(input, index, current, move, outcome);
   }
 }
