@@ -30,6 +30,7 @@ AgentBits* new_block(std::size_t capacity) {
 static_assert(sizeof(AgentBits) + 2 * sizeof(Interval) == 64);
 
 alignas(NewcomerWindows::kLine) const AgentBits NewcomerWindows::kNoAgents{};
+const NewcomerWindows TimelineSet::kNoNewcomerWindows{};
 
 NewcomerWindows::NewcomerWindows(const NewcomerWindows& other) {
   if (other.capacity_ == 0) return;  // the shared empty block

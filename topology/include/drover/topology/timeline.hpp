@@ -345,8 +345,7 @@ class TimelineSet {
   ///         revision moves): valid until the set changes. Empty for an entity not owned.
   ///         Inline: a planner asks for every entity it reads.
   const NewcomerWindows& newcomer_windows(EntityIndex entity) const noexcept {
-    static const NewcomerWindows kNone;  // entities not owned have no windows there either
-    return entity < newcomers_.of.size() ? newcomers_.of[entity] : kNone;
+    return entity < newcomers_.of.size() ? newcomers_.of[entity] : kNoNewcomerWindows;
   }
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
@@ -525,6 +524,9 @@ class TimelineSet {
     friend bool operator==(const Revisions&, const Revisions&) { return true; }
   };
   Revisions revisions_;
+  // What newcomer_windows gives for an entity out of range: none. Not a local static of
+  // it, whose guard every call would test.
+  static const NewcomerWindows kNoNewcomerWindows;
   // Per entity, see newcomer_windows: recomputed whenever its windows revision moves
   // (every change of what free windows read moves it), in the pass that moves it. Planners
   // read them for every entity they touch, and sweeping the reservations then was
