@@ -61,7 +61,7 @@ constexpr topology::RouteId kRoute = 1;
 /// call on virtualised hosts (1.4 us on the development machine, with the TLB flushed on the
 /// way in and out), which every plan paid and the A* run, timed once, did not. This one is
 /// read in user space (vDSO, 27 ns there). Wall time counts what other processes take from
-/// the thread: the medians over --repeat runs leave such runs out.
+/// the thread: with --repeat, the medians leave such runs out.
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
       .count();

@@ -59,10 +59,6 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
   return kUnreachable;  // every vertex connected with the root is closed, and `vertex` is not
 }
 
-// When every arc takes the same time, a first-in first-out queue holds the vertices in order
-// of distance, so a vertex's first distance is its shortest: it is closed (~distance) as soon
-// as it is found, and distance() answers it inline from then on. No keys, no division, each
-// vertex queued once, and only the vertex ids of the arcs read.
 namespace {
 
 /// stored = old unless old is kUnreachable, by a conditional move: GCC 12 makes a branch
@@ -80,6 +76,10 @@ namespace {
 
 }  // namespace
 
+// When every arc takes the same time, a first-in first-out queue holds the vertices in order
+// of distance, so a vertex's first distance is its shortest: it is closed (~distance) as soon
+// as it is found, and distance() answers it inline from then on. No keys, no division, each
+// vertex queued once, and only the vertex ids of the arcs read.
 template <Direction kDirection>
 DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
                                                     const Traversal& traversal,

@@ -45,10 +45,10 @@ class DistanceTable {
   topology::EntityIndex root() const noexcept { return root_; }
 
   /// Breadth-first tables whose labels take up to this many bytes search without a branch:
-  /// a third of a small L1 data cache (32 KiB), so that the labels stay there. Bench plan
+  /// well within a small L1 data cache (32 KiB), so that the labels stay there. Bench plan
   /// on random-32-32-20 (819 vertices, 6.5 KiB of labels), ten alternating runs: ratio to
   /// A* 3.52 -> 3.36 at N = 200, 3.51 -> 3.18 at N = 400. warehouse-10-20-10-2-1 (5 699
-  /// vertices, 45 KiB) keeps the branch, which was faster there without one.
+  /// vertices, 45 KiB) keeps the branch, which was faster there.
   static constexpr std::size_t kBranchlessBytes = 12 * 1024;
 
   /// The reservation-free travel time between `vertex` and the root (in the table's

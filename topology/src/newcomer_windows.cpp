@@ -55,7 +55,8 @@ void NewcomerWindows::add_agent(AgentBits::Key key) {
 }
 
 void NewcomerWindows::assign(std::span<const Interval> windows) {
-  reserve(windows.size());
+  // No windows need no block of their own (an entity not owned keeps the shared one).
+  if (!windows.empty()) reserve(windows.size());
   std::copy(windows.begin(), windows.end(), first());
   size_ = static_cast<std::uint32_t>(windows.size());
 }

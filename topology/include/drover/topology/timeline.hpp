@@ -318,7 +318,10 @@ class TimelineSet {
     friend struct TimelineSet::Impl;
     static constexpr std::size_t kLine = 64;
     /// The windows follow the agents in the block.
-    Interval* first() const noexcept { return reinterpret_cast<Interval*>(block_ + 1); }
+    const Interval* first() const noexcept {
+      return reinterpret_cast<const Interval*>(block_ + 1);
+    }
+    Interval* first() noexcept { return reinterpret_cast<Interval*>(block_ + 1); }
     void swap(NewcomerWindows& other) noexcept {
       std::swap(block_, other.block_);
       std::swap(size_, other.size_);
