@@ -29,10 +29,6 @@ bool same_agent(const std::string& a, std::string_view b) {
   return a.size() == b.size() && (b.empty() || a.back() == b.back()) && a == b;
 }
 
-}  // namespace
-
-namespace {
-
 /// What cutting an interval out of sorted, disjoint windows changes: the windows
 /// [first, last) overlap it, and what is left of them is pieces[0, count), in order.
 struct WindowCut {
