@@ -24,7 +24,8 @@ constexpr int kLateProofRounds = 8;
 
 void WindowSearch::begin(const SearchInput& input) {
   if (++generation_ == 0) {  // wrapped: every stamp could look current
-    for (EntityWindows& e : entities_) e.stamp = 0;
+    for (QueriedWindows& q : queried_) q.stamp = 0;
+    for (WindowIds& ids : window_ids_of_) ids.stamp = 0;
     std::fill(block_stamp_.begin(), block_stamp_.end(), 0);
     std::fill(region_stamp_.begin(), region_stamp_.end(), 0);
     from_start_generation_ = 0;
@@ -32,9 +33,9 @@ void WindowSearch::begin(const SearchInput& input) {
   }
   const RoutingGraph& graph = *input.graph;
   const std::size_t entities = graph.topology().entity_count();
-  if (entities_.size() != entities) {
-    entities_.assign(entities, EntityWindows{});
-    entity_ids_.assign(entities, 0);
+  if (queried_.size() != entities) {
+    queried_.assign(entities, QueriedWindows{});
+    window_ids_of_.assign(entities, WindowIds{});
   }
   agent_bits_ = topology::TimelineSet::AgentBits::key(input.agent);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
@@ -60,31 +61,12 @@ void WindowSearch::begin(const SearchInput& input) {
   path_.clear();
 }
 
-void WindowSearch::read_windows(const SearchInput& input, EntityIndex entity) {
-  const Interval* first = nullptr;
-  std::uint32_t count = 0;
-  const topology::TimelineSet::NewcomerWindows& newcomer =
-      input.timelines->newcomer_windows(entity);
-  if (input.count_locks && !newcomer.agents().may_contain(agent_bits_)) {
-    // Served in place, without those that end by the start time. The first may start
-    // before it; the search never gets there before it, and every reader takes a window
-    // start as "free from", so that start only weakens bounds.
-    first = newcomer.windows().data();
-    count = static_cast<std::uint32_t>(newcomer.windows().size());
-    const std::uint32_t past = ending_after(first, count, input.start_time);
-    first += past;
-    count -= past;
-  } else {
-    // Locks ignored, or the agent may have reservations there, which never block it.
-    scratch_.clear();
-    input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever,
-                                         scratch_, input.count_locks);
-    first = own_windows_.store(scratch_);
-    count = static_cast<std::uint32_t>(scratch_.size());
-  }
-  entities_[entity] = EntityWindows{first, count, generation_};
-  entity_ids_[entity] = window_ids_;
-  window_ids_ += count;
+void WindowSearch::query_windows(const SearchInput& input, EntityIndex entity) {
+  scratch_.clear();
+  input.timelines->append_free_windows(entity, input.agent, input.start_time, kForever, scratch_,
+                                       input.count_locks);
+  queried_[entity] = QueriedWindows{own_windows_.store(scratch_),
+                                    static_cast<std::uint32_t>(scratch_.size()), generation_};
 }
 
 const Interval* WindowSearch::WindowStore::store(const std::vector<Interval>& windows) {
@@ -165,7 +147,7 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   const DurationNs clearance = input.traversal->clearance(arc);
   std::uint32_t count = 0;
   const Interval* first = windows_of(input, input.graph->arc(arc).edge, count);
-  for (std::uint32_t e = 0; e < count; ++e) {
+  for (std::uint32_t e = ending_after(first, count, input.start_time); e < count; ++e) {
     const Interval edge = first[e];
     const TimeNs onto_edge = std::max(edge.start, input.start_time);
     if (onto_edge + travel >= bound) break;
@@ -258,13 +240,13 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
   };
   // A state is expanded again when only its cap grew: its successors' caps may grow too.
   // `from_start`: travel_from_start of the vertex.
-  const auto reach = [this, kind](EntityIndex vertex, std::uint32_t window,
-                                  DurationNs from_start, TimeNs latest, TimeNs cap) {
+  const auto reach = [this, kind, &input](EntityIndex vertex, std::uint32_t window,
+                                          DurationNs from_start, TimeNs latest, TimeNs cap) {
+    const std::uint32_t id = window_id(input, vertex, window);
     if (late_stamp_.size() < window_ids_) {
       late_stamp_.resize(window_ids_, 0);
       late_labels_.resize(window_ids_);
     }
-    const std::uint32_t id = window_id(vertex, window);
     LateLabel& label = late_labels_[id];
     if (late_stamp_[id] == late_generation_) {
       if (latest <= label.latest && cap <= label.cap) return;
@@ -292,8 +274,6 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
   if (held.start > deadline) return LateProof{true, held.start - deadline};
   const EntityIndex stop = input.legs.back().stop;
   reach(stop, goal_count - 1, travel_from_start(input, kind, stop), deadline, kForever);
-  std::uint32_t start_count = 0;
-  windows_of(input, input.start, start_count);  // the start's first window is its window 0
 
   std::size_t visited = 0;
   while (!late_open_.empty()) {
@@ -301,13 +281,13 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
     const LateLabel& label = late_labels_[top.id];
     if (label.latest != top.latest || label.cap != top.cap) continue;  // superseded
     if (++visited > budget) return LateProof{};
-    if (top.vertex == input.start && top.window == 0) {
+    if (top.vertex == input.start && top.window == start_window_) {
       // The search's first state: ready at the start time, and never reached again.
       if (top.latest >= input.start_time) return LateProof{false, 0, true};
       fails_by(input.start_time, top.latest, top.cap);
       continue;
     }
-    const Interval into = clipped(window_of(top.vertex, top.window));
+    const Interval into = clipped(window_of(input, top.vertex, top.window));
     for (const ArcIndex a : graph.arcs_into(top.vertex)) {
       const EntityIndex from = graph.arc(a).from;
       if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
@@ -436,7 +416,7 @@ template <class Arrive>
   const DurationNs travel = move.travel;
   const DurationNs clearance = move.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
-  const TimeNs latest_onto_edge = window_of(current.vertex, current.window).end - clearance;
+  const TimeNs latest_onto_edge = window_of(input, current.vertex, current.window).end - clearance;
   if (current.ready > latest_onto_edge) return;
 
   std::uint32_t edge_count = 0, vertex_count = 0;
@@ -498,7 +478,8 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
 void WindowSearch::follow_labels(const SearchInput& input) {
   const Leg& last = input.legs.back();
   const Traversal::Adjacency& adjacency = input.traversal->adjacency(*input.graph);
-  State at{input.start_time, input.start_time, 0, kNone, kNone, input.start, 0, 0, false};
+  State at{input.start_time, input.start_time, 0, kNone, kNone, input.start, start_window_, 0,
+           false};
   path_.assign(1, at);
   while (at.vertex != last.stop || !completes(input, at)) {
     State next{};
@@ -507,7 +488,7 @@ void WindowSearch::follow_labels(const SearchInput& input) {
       const DurationNs h = last.table->distance(*input.graph, *input.traversal, move.to);
       if (h > next_h) continue;
       arrivals(input, at, move, [&](std::uint32_t j, TimeNs onto_edge, TimeNs arrival) {
-        const std::uint32_t id = window_id(move.to, j);
+        const std::uint32_t id = window_id(input, move.to, j);
         if (id >= late_stamp_.size() || late_stamp_[id] != late_generation_ ||
             arrival > late_labels_[id].latest) {
           return true;  // no route on from there by the deadline; a later window may have one
@@ -525,9 +506,9 @@ void WindowSearch::follow_labels(const SearchInput& input) {
   }
 }
 
-bool WindowSearch::completes(const SearchInput& input, const State& state) const {
+bool WindowSearch::completes(const SearchInput& input, const State& state) {
   const DurationNs hold = input.legs.back().dwell;
-  const TimeNs end = window_of(state.vertex, state.window).end;
+  const TimeNs end = window_of(input, state.vertex, state.window).end;
   return hold == kForever ? end == kForever : state.ready + hold <= end;
 }
 
@@ -536,7 +517,8 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   SearchOutcome outcome;
   std::uint32_t count = 0;
   const Interval* first = windows_of(input, input.start, count);
-  if (count == 0 || first[0].start > input.start_time) return outcome;
+  start_window_ = ending_after(first, count, input.start_time);
+  if (start_window_ == count || first[start_window_].start > input.start_time) return outcome;
   outcome.start_free = true;
   // Every state's key is at least this: states that could only reach the goal before it
   // is free would otherwise all be expanded first, in order of a bound that cannot be met.
@@ -544,8 +526,8 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   if (arrival_floor_ == kForever) return outcome;  // the stop can never be entered and held
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
-  improve(states_of(input, 0, input.start), input.start_time, input.start_time, kNone, kNone,
-          0, start_estimate);
+  improve(states_of(input, 0, input.start) + start_window_, input.start_time, input.start_time,
+          kNone, kNone, 0, start_estimate);
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
@@ -592,7 +574,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
 void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const State& current,
                           SearchOutcome& outcome) {
   const EntityIndex vertex = current.vertex;
-  const TimeNs window_end = window_of(current.vertex, current.window).end;
+  const TimeNs window_end = window_of(input, current.vertex, current.window).end;
   const Leg& leg = input.legs[current.layer];
   if (vertex == leg.stop && current.layer + 1u < input.legs.size()) {
     // Make the stop: stay for the dwell, then head for the next one from here.

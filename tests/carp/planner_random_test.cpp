@@ -84,7 +84,8 @@ class BruteForce {
     if (restriction_violation(t_.vertex(request_.start).restrictions, request_.vehicle)) {
       return std::nullopt;
     }
-    at(0, request_.start, 0) = 0;
+    const int start_time = static_cast<int>(request_.start_time / kNsPerSecond);
+    at(0, request_.start, start_time) = start_time;
     std::optional<int> arrival;
     for (int x = 0; x < kGrid; ++x) {
       for (std::size_t k = 0; k < layers; ++k) {
@@ -255,9 +256,11 @@ struct ProofUse {
 /// (which must never pass the earliest arrival, whatever the search's luck in finding it).
 /// `open_ended_only`: requests with one open-ended stop, and every fourth trial with small
 /// proof budgets (1 to 32 states), so that proofs also give up and try again.
-/// `use`: what the proofs did, if asked. `parked`: as for random_traffic.
+/// `use`: what the proofs did, if asked. `parked`: as for random_traffic. `latest_start`:
+/// requests start at a random whole second up to it (0: at time 0).
 void check_against_brute_force(PlannerOptions options, int trials, bool open_ended_only = false,
-                               ProofUse* use = nullptr, double parked = 0.03) {
+                               ProofUse* use = nullptr, double parked = 0.03,
+                               int latest_start = 0) {
   const std::size_t budget = options.floor_proof_budget;
   const std::size_t quick_budget = options.quick_proof_budget;
   std::mt19937 rng(20240611);
@@ -270,7 +273,10 @@ void check_against_brute_force(PlannerOptions options, int trials, bool open_end
     options.quick_proof_budget = small ? 1 + trial / 4 % 32 : quick_budget;
     World w(random_grid(rng), options);
     const std::vector<Blocker> blockers = random_traffic(w, rng, parked);
-    const PlanRequest request = random_request(w, rng, open_ended_only);
+    PlanRequest request = random_request(w, rng, open_ended_only);
+    if (latest_start > 0) {
+      request.start_time = sec(std::uniform_int_distribution<int>(0, latest_start)(rng));
+    }
     const auto expected = BruteForce(w.topology, blockers, request).earliest_arrival();
     const auto planned = w.planner.plan(w.timelines, request);
     const PlanStats stats = w.planner.last_stats();
@@ -310,6 +316,12 @@ TEST(PlannerRandom, RoutesAreValidCollisionFreeAndArriveAtTheEarliestPossibleTim
   check_against_brute_force(PlannerOptions{.horizon = sec(1000)}, 400);
 }
 
+// Starting later, the windows that ended before the start time are still in the timelines'
+// views the planner reads in place, and the start's window need not be the first.
+TEST(PlannerRandom, RoutesFromALaterStartTimeArriveAtTheEarliestPossibleTime) {
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000)}, 400, false, nullptr, 0.03, 30);
+}
+
 // The small grids seldom make a search expand hundreds of states keyed by the arrival floor,
 // so here every search tries to prove its floor too early after one, with a budget no
 // small grid exhausts (a budget of one state, as when it was tied to the trigger, let few
@@ -330,6 +342,18 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByProofsKeepsTheEarliestArrival) {
   // The proofs must have been put to work, both ways.
   EXPECT_GT(use.raised, 150) << use.raised;
   EXPECT_GT(use.routes, 300) << use.routes;
+}
+
+// The same from later start times: the backward searches must stop at the start's window.
+TEST(PlannerRandom, RaisingTheArrivalFloorFromALaterStartTimeKeepsTheEarliestArrival) {
+  ProofUse use;
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .quick_proof_after = 0,
+                                           .floor_proof_after = 1,
+                                           .floor_proof_budget = 1 << 20},
+                            600, true, &use, 0.03, 30);
+  EXPECT_GT(use.raised, 50) << use.raised;
+  EXPECT_GT(use.routes, 100) << use.routes;
 }
 
 // The same for quick proofs alone (how early a route reaches a vertex bounded by the
