@@ -299,7 +299,7 @@ struct Planner::Impl {
   }
 
   /// True when the search could start: a free window of the start vertex begins at the
-  /// start time (the search's own test, on the same query).
+  /// start time (what the search tests on the windows it reads).
   bool start_free(const TimelineSet& timelines, const PlanRequest& request) {
     start_windows.clear();
     timelines.append_free_windows(request.start, request.agent, request.start_time, kForever,

@@ -91,9 +91,13 @@ void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::ui
                               EntityIndex vertex) {
   block_stamp_[key] = generation_;
   std::uint32_t count = 0;
-  windows_of(input, vertex, count);
-  block_first_[key] = static_cast<std::uint32_t>(states_.size());
-  for (std::uint32_t i = 0; i < count; ++i) {
+  const Interval* first = windows_of(input, vertex, count);
+  // Windows that ended by the start time are never reached (every arrival is later): no
+  // states for them. The block's index still counts them (unsigned arithmetic wraps back),
+  // so that block + window stays the state of that window.
+  const std::uint32_t ended = ending_after(first, count, input.start_time);
+  block_first_[key] = static_cast<std::uint32_t>(states_.size()) - ended;
+  for (std::uint32_t i = ended; i < count; ++i) {
     states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, i,
                             static_cast<std::uint16_t>(layer), false});
   }
@@ -134,7 +138,7 @@ TimeNs WindowSearch::arrival_floor(const SearchInput& input) {
 TimeNs WindowSearch::held_after(const SearchInput& input, TimeNs at) {
   std::uint32_t count = 0;
   const Interval* first = windows_of(input, input.legs.back().stop, count);
-  for (std::uint32_t g = 0; g < count; ++g) {
+  for (std::uint32_t g = ending_after(first, count, at); g < count; ++g) {
     if (const TimeNs t = held_from(input, first[g], at); t != kForever) return t;
   }
   return kForever;

@@ -212,8 +212,9 @@ class WindowSearch {
   /// never gets there before it, and every reader takes a window start as "free from", so
   /// that start only weakens bounds). Otherwise from an exact query, from the start time on.
   /// Inline: no record of the search's own stands between it and the timelines (bench plan,
-  /// in-process A/B over 30 repeats: ratio to A* -2 % at random N = 200, -4 % at N = 400,
-  /// -2 % at warehouse N = 400, against a stamped record per entity read first).
+  /// in-process A/B over 30 repeats, two runs: ratio to A* -1 to -3 % at random N = 200, -3
+  /// to -4 % at N = 400, -2 % at warehouse N = 400, against a stamped record per entity read
+  /// first).
   const topology::Interval* windows_of(const SearchInput& input, topology::EntityIndex entity,
                                        std::uint32_t& count) {
     const topology::TimelineSet::NewcomerWindows& newcomer =
@@ -280,14 +281,16 @@ class WindowSearch {
     std::size_t block_ = 0;  // the block being filled
     std::size_t used_ = 0;   // of it
   };
-  /// The index of the state for window 0 of (layer, vertex); its other windows follow.
+  /// The index of the state for window 0 of (layer, vertex); its other windows follow (those
+  /// that ended by the start time have none: see add_states).
   std::uint32_t states_of(const SearchInput& input, std::uint32_t layer,
                           topology::EntityIndex vertex) {
     const std::size_t key = layer * input.graph->vertex_count() + vertex;
     if (block_stamp_[key] != generation_) add_states(input, key, layer, vertex);
     return block_first_[key];
   }
-  /// Adds the (unreached) states of (layer, vertex), one per window, under `key`.
+  /// Adds the (unreached) states of (layer, vertex), one per window that ends after the
+  /// start time, under `key`.
   void add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
                   topology::EntityIndex vertex);
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.

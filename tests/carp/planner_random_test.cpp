@@ -370,6 +370,18 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) 
   EXPECT_GT(use.routes, 300) << use.routes;
 }
 
+// And from later start times.
+TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsFromALaterStartTimeKeepsTheEarliestArrival) {
+  ProofUse use;
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .quick_proof_after = 1,
+                                           .quick_proof_budget = 1 << 20,
+                                           .floor_proof_after = std::size_t{1} << 40},
+                            600, true, &use, 0.03, 30);
+  EXPECT_GT(use.raised, 50) << use.raised;
+  EXPECT_GT(use.routes, 100) << use.routes;
+}
+
 // Shut-in proofs end a search with no route: here every search for one open-ended stop
 // checks after its first state whether the stop is shut in (in a region of any size), and
 // tries the proof with a budget no small grid exhausts, among agents parked for good half of
@@ -382,6 +394,17 @@ TEST(PlannerRandom, ShutInProofsRefuseOnlyRequestsWithoutARoute) {
                                            .shut_in_budget = 1 << 20},
                             1200, true, &use, 0.5);
   EXPECT_GT(use.shut_in, 40) << use.shut_in;
+}
+
+// And from later start times.
+TEST(PlannerRandom, ShutInProofsFromALaterStartTimeRefuseOnlyRequestsWithoutARoute) {
+  ProofUse use;
+  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
+                                           .shut_in_after = 1,
+                                           .shut_in_region = 1 << 20,
+                                           .shut_in_budget = 1 << 20},
+                            600, true, &use, 0.5, 30);
+  EXPECT_GT(use.shut_in, 20) << use.shut_in;
 }
 
 TEST(PlannerRandom, AgentsPlannedOneAfterAnotherNeverCollide) {
