@@ -415,12 +415,13 @@ WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estima
 template <class Arrive>
 [[gnu::always_inline]] inline void WindowSearch::arrivals(const SearchInput& input,
                                                           const State& current,
+                                                          TimeNs window_end,
                                                           const Traversal::Move& move,
                                                           Arrive&& arrive) {
   const DurationNs travel = move.travel;
   const DurationNs clearance = move.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
-  const TimeNs latest_onto_edge = window_of(input, current.vertex, current.window).end - clearance;
+  const TimeNs latest_onto_edge = window_end - clearance;
   if (current.ready > latest_onto_edge) return;
 
   std::uint32_t edge_count = 0, vertex_count = 0;
@@ -446,7 +447,8 @@ template <class Arrive>
 }
 
 void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const State& current,
-                         const Traversal::Move& move, SearchOutcome& outcome) {
+                         TimeNs window_end, const Traversal::Move& move,
+                         SearchOutcome& outcome) {
   std::uint32_t block = kNone;
   DurationNs to_go = -1;  // the heuristic of move.to, looked up only if a state improves
   // Forced inline (GCC left it a call once improve was inlined into it): -1 % planner
@@ -467,7 +469,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     __builtin_prefetch(input.traversal->adjacency(*input.graph).out_of(move.to).data());
     return true;
   };
-  arrivals(input, current, move, arrive);
+  arrivals(input, current, window_end, move, arrive);
 }
 
 // Why a successor always exists (the converse of prove_late's soundness): a state's label
@@ -488,10 +490,11 @@ void WindowSearch::follow_labels(const SearchInput& input) {
   while (at.vertex != last.stop || !completes(input, at)) {
     State next{};
     DurationNs next_h = kUnreachable;
+    const TimeNs window_end = window_of(input, at.vertex, at.window).end;
     for (const Traversal::Move& move : adjacency.out_of(at.vertex)) {
       const DurationNs h = last.table->distance(*input.graph, *input.traversal, move.to);
       if (h > next_h) continue;
-      arrivals(input, at, move, [&](std::uint32_t j, TimeNs onto_edge, TimeNs arrival) {
+      arrivals(input, at, window_end, move, [&](std::uint32_t j, TimeNs onto_edge, TimeNs arrival) {
         const std::uint32_t id = window_id(input, move.to, j);
         if (id >= late_stamp_.size() || late_stamp_[id] != late_generation_ ||
             arrival > late_labels_[id].latest) {
@@ -604,7 +607,7 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
     __builtin_prefetch(input.timelines->newcomer_windows(move.to).windows().data());
   }
   for (const Traversal::Move& move : moves) {
-    drive(input, index, current, move, outcome);
+    drive(input, index, current, window_end, move, outcome);
   }
 }
 

@@ -296,17 +296,18 @@ class WindowSearch {
   /// The heuristic of (layer, vertex), kUnreachable when the goal cannot be reached.
   DurationNs estimate(const SearchInput& input, std::uint32_t layer, topology::EntityIndex vertex);
   /// Calls arrive(j, onto_edge, arrival) for every window j of move.to that the vehicle
-  /// reaches from `current` by `move`: entering the edge at `onto_edge`, arriving at
-  /// `arrival`, both the earliest possible; in order of the edge's windows, and for each of
-  /// the destination's windows in order. When arrive returns false, the destination's later
-  /// windows are skipped for that edge window (they are reached later still).
+  /// reaches from `current` (whose window ends at `window_end`) by `move`: entering the edge
+  /// at `onto_edge`, arriving at `arrival`, both the earliest possible; in order of the
+  /// edge's windows, and for each of the destination's windows in order. When arrive returns
+  /// false, the destination's later windows are skipped for that edge window (they are
+  /// reached later still).
   template <class Arrive>
-  void arrivals(const SearchInput& input, const State& current, const Traversal::Move& move,
-                Arrive&& arrive);
-  /// Drives `move` from state `from` (`current`, a copy: states_ may grow) into every
-  /// window of its destination it can reach.
+  void arrivals(const SearchInput& input, const State& current, TimeNs window_end,
+                const Traversal::Move& move, Arrive&& arrive);
+  /// Drives `move` from state `from` (`current`, a copy: states_ may grow; its window ends
+  /// at `window_end`) into every window of its destination it can reach.
   void drive(const SearchInput& input, std::uint32_t from, const State& current,
-             const Traversal::Move& move, SearchOutcome& outcome);
+             TimeNs window_end, const Traversal::Move& move, SearchOutcome& outcome);
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
                std::uint32_t arc, TimeNs edge_entry, DurationNs estimate);
   bool completes(const SearchInput& input, const State& state);
