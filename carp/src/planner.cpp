@@ -287,7 +287,10 @@ struct Planner::Impl {
         const DurationNs to_go = table.distance(*graph, traversal, at);
         const auto moves = traversal.adjacency(*graph).out_of(at);
         const auto next = std::find_if(moves.begin(), moves.end(), [&](const Traversal::Move& m) {
-          return m.travel + table.distance(*graph, traversal, m.to) == to_go;
+          // Moves towards vertices that cannot reach the stop are skipped before the sum
+          // (kUnreachable plus a travel time overflows).
+          const DurationNs rest = table.distance(*graph, traversal, m.to);
+          return rest != kUnreachable && m.travel + rest == to_go;
         });
         if (next == moves.end()) break;  // never: prepare_legs found the stop reachable
         at = next->to;
