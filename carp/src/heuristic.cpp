@@ -142,7 +142,7 @@ template class DistanceTable<Direction::from_root>;
 HeuristicTable& HeuristicCache::table(const RoutingGraph& graph, std::uint64_t class_id,
                                       EntityIndex goal) {
   for (Entry& entry : entries_) {
-    if (entry.class_id == class_id && entry.table->root() == goal) {
+    if (entry.class_id == class_id && entry.goal == goal) {
       entry.kept = entry.kept || entry.last_request != request_;  // a second request
       entry.last_request = request_;
       return *entry.table;
@@ -151,11 +151,11 @@ HeuristicTable& HeuristicCache::table(const RoutingGraph& graph, std::uint64_t c
   const bool kept = recall(class_id, goal);
   Entry* slot = entries_.size() < capacity_ ? nullptr : victim();
   if (slot == nullptr) {
-    entries_.push_back(Entry{std::make_unique<HeuristicTable>(), 0, 0, false});
+    entries_.push_back(Entry{std::make_unique<HeuristicTable>()});
     slot = &entries_.back();
   } else if (!slot->kept) {
     // Remember the pair replaced on probation, in a ring of capacity_ pairs.
-    const Pair pair{slot->class_id, slot->table->root()};
+    const Pair pair{slot->class_id, slot->goal};
     if (replaced_.size() < capacity_) {
       replaced_.push_back(pair);
     } else {
@@ -163,6 +163,7 @@ HeuristicTable& HeuristicCache::table(const RoutingGraph& graph, std::uint64_t c
       replaced_next_ = (replaced_next_ + 1) % capacity_;
     }
   }
+  slot->goal = goal;
   slot->class_id = class_id;
   slot->last_request = request_;
   slot->kept = kept;

@@ -116,6 +116,9 @@ class HeuristicCache {
  private:
   struct Entry {
     std::unique_ptr<HeuristicTable> table;
+    /// The table's root, kept here too: a lookup compares every entry, and reading it from
+    /// the table would touch as many tables.
+    topology::EntityIndex goal = topology::kNoEntity;
     std::uint64_t class_id = 0;
     std::uint64_t last_request = 0;
     bool kept = false;  ///< protected: asked for by a second request
