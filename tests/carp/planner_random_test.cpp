@@ -312,6 +312,33 @@ void check_against_brute_force(PlannerOptions options, int trials, bool open_end
   EXPECT_GT(refused, trials / 20);
 }
 
+/// A full floor proof after each expansion keyed by the floor, with a budget no small grid
+/// exhausts; no quick proofs.
+PlannerOptions full_proofs_at_every_floor() {
+  return PlannerOptions{.horizon = sec(1000),
+                        .quick_proof_after = 0,
+                        .floor_proof_after = 1,
+                        .floor_proof_budget = 1 << 20};
+}
+
+/// A quick floor proof after each expansion keyed by the floor, with a budget no small grid
+/// exhausts; no full proofs.
+PlannerOptions quick_proofs_at_every_floor() {
+  return PlannerOptions{.horizon = sec(1000),
+                        .quick_proof_after = 1,
+                        .quick_proof_budget = 1 << 20,
+                        .floor_proof_after = std::size_t{1} << 40};
+}
+
+/// The shut-in check after the first expansion, in a region of any size, and its proof
+/// with a budget no small grid exhausts.
+PlannerOptions shut_in_proofs_at_once() {
+  return PlannerOptions{.horizon = sec(1000),
+                        .shut_in_after = 1,
+                        .shut_in_region = 1 << 20,
+                        .shut_in_budget = 1 << 20};
+}
+
 TEST(PlannerRandom, RoutesAreValidCollisionFreeAndArriveAtTheEarliestPossibleTime) {
   check_against_brute_force(PlannerOptions{.horizon = sec(1000)}, 400);
 }
@@ -334,11 +361,7 @@ TEST(PlannerRandom, RoutesFromALaterStartTimeArriveAtTheEarliestPossibleTime) {
 // its labels lead to: those are checked like the search's own.
 TEST(PlannerRandom, RaisingTheArrivalFloorByProofsKeepsTheEarliestArrival) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .quick_proof_after = 0,
-                                           .floor_proof_after = 1,
-                                           .floor_proof_budget = 1 << 20},
-                            1200, true, &use);
+  check_against_brute_force(full_proofs_at_every_floor(), 1200, true, &use);
   // The proofs must have been put to work, both ways.
   EXPECT_GT(use.raised, 150) << use.raised;
   EXPECT_GT(use.routes, 300) << use.routes;
@@ -347,11 +370,7 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByProofsKeepsTheEarliestArrival) {
 // The same from later start times: the backward searches must stop at the start's window.
 TEST(PlannerRandom, RaisingTheArrivalFloorFromALaterStartTimeKeepsTheEarliestArrival) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .quick_proof_after = 0,
-                                           .floor_proof_after = 1,
-                                           .floor_proof_budget = 1 << 20},
-                            600, true, &use, 0.03, 30);
+  check_against_brute_force(full_proofs_at_every_floor(), 600, true, &use, 0.03, 30);
   EXPECT_GT(use.raised, 50) << use.raised;
   EXPECT_GT(use.routes, 100) << use.routes;
 }
@@ -361,11 +380,7 @@ TEST(PlannerRandom, RaisingTheArrivalFloorFromALaterStartTimeKeepsTheEarliestArr
 // expansion, as each raise starts the count again.
 TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .quick_proof_after = 1,
-                                           .quick_proof_budget = 1 << 20,
-                                           .floor_proof_after = std::size_t{1} << 40},
-                            1200, true, &use);
+  check_against_brute_force(quick_proofs_at_every_floor(), 1200, true, &use);
   EXPECT_GT(use.raised, 150) << use.raised;
   EXPECT_GT(use.routes, 300) << use.routes;
 }
@@ -373,11 +388,7 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsKeepsTheEarliestArrival) 
 // And from later start times.
 TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsFromALaterStartTimeKeepsTheEarliestArrival) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .quick_proof_after = 1,
-                                           .quick_proof_budget = 1 << 20,
-                                           .floor_proof_after = std::size_t{1} << 40},
-                            600, true, &use, 0.03, 30);
+  check_against_brute_force(quick_proofs_at_every_floor(), 600, true, &use, 0.03, 30);
   EXPECT_GT(use.raised, 50) << use.raised;
   EXPECT_GT(use.routes, 100) << use.routes;
 }
@@ -388,22 +399,14 @@ TEST(PlannerRandom, RaisingTheArrivalFloorByQuickProofsFromALaterStartTimeKeepsT
 // the time. A wrong proof would refuse a request the brute force routes.
 TEST(PlannerRandom, ShutInProofsRefuseOnlyRequestsWithoutARoute) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .shut_in_after = 1,
-                                           .shut_in_region = 1 << 20,
-                                           .shut_in_budget = 1 << 20},
-                            1200, true, &use, 0.5);
+  check_against_brute_force(shut_in_proofs_at_once(), 1200, true, &use, 0.5);
   EXPECT_GT(use.shut_in, 40) << use.shut_in;
 }
 
 // And from later start times.
 TEST(PlannerRandom, ShutInProofsFromALaterStartTimeRefuseOnlyRequestsWithoutARoute) {
   ProofUse use;
-  check_against_brute_force(PlannerOptions{.horizon = sec(1000),
-                                           .shut_in_after = 1,
-                                           .shut_in_region = 1 << 20,
-                                           .shut_in_budget = 1 << 20},
-                            600, true, &use, 0.5, 30);
+  check_against_brute_force(shut_in_proofs_at_once(), 600, true, &use, 0.5, 30);
   EXPECT_GT(use.shut_in, 20) << use.shut_in;
 }
 
