@@ -61,16 +61,16 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
 
 namespace {
 
-/// stored = old unless old is kUnreachable, by a conditional move: GCC 12 makes a branch
-/// of every way of writing this in C++ but mask arithmetic (more instructions).
-[[gnu::always_inline]] inline void keep_if_found(DurationNs& stored, DurationNs old) {
+/// stored = old if old is negative (a closed label), by a conditional move: GCC 12 makes a
+/// branch of every way of writing this in C++ but mask arithmetic (more instructions).
+[[gnu::always_inline]] inline void keep_if_closed(DurationNs& stored, DurationNs old) {
 #if defined(__x86_64__)
-  asm("cmpq %[unreachable], %[old]\n\tcmovneq %[old], %[stored]"
+  asm("testq %[old], %[old]\n\tcmovsq %[old], %[stored]"
       : [stored] "+r"(stored)
-      : [old] "r"(old), [unreachable] "r"(kUnreachable)
+      : [old] "r"(old)
       : "cc");
 #else
-  stored = old != kUnreachable ? old : stored;
+  stored = old < 0 ? old : stored;
 #endif
 }
 
@@ -105,6 +105,8 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
     const std::span<const EntityIndex> next = kDirection == Direction::to_root
                                                   ? adjacency.sources_of(top)
                                                   : adjacency.targets_of(top);
+    // Every label here is closed (negative) or kUnreachable (not found yet, positive): the
+    // sign alone says whether a vertex was found.
     if (small) {
       for (const EntityIndex v : next) {
         // A vertex found already keeps its label, at its shortest, and the slot written
@@ -112,10 +114,10 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
         // with every label in L1 a misprediction costs more than the stores.
         DurationNs stored = ~through;
         const DurationNs old = label[v];
-        keep_if_found(stored, old);
+        keep_if_closed(stored, old);
         label[v] = stored;
         queue[tail] = v;
-        tail += old == kUnreachable ? 1 : 0;
+        tail += 1 + (old >> 63);  // 0 if found (old >> 63 is -1 for a negative label)
       }
     } else {
       for (const EntityIndex v : next) {
@@ -123,7 +125,7 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
         // choice), which suits the warehouse's aisles, where it predicts well and lets the
         // cache misses of later labels overlap.
         const DurationNs old = label[v];
-        const bool found = old != kUnreachable;
+        const bool found = old < 0;
         label[v] = found ? old : ~through;
         queue[tail] = v;
         tail += found ? 0 : 1;
