@@ -578,6 +578,14 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   return outcome;
 }
 
+EntityIndex WindowSearch::came_from_last_window(const SearchInput& input, const State& state) {
+  if (state.arc == kNone) return topology::kNoEntity;  // the start, or a stop made in place
+  const State& parent = states_[state.parent];
+  std::uint32_t count = 0;
+  windows_of(input, parent.vertex, count);
+  return parent.window + 1 == count ? parent.vertex : topology::kNoEntity;
+}
+
 void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const State& current,
                           SearchOutcome& outcome) {
   const EntityIndex vertex = current.vertex;
@@ -596,6 +604,12 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
     }
   }
   const auto moves = input.traversal->adjacency(*input.graph).out_of(vertex);
+  // Back where the state came from, the vehicle arrives later than it was there, so it can
+  // only reach windows of that vertex after the one it left: none if that was the last.
+  // The move is then skipped, reads and all (in-process A/B over 30 repeats, six runs:
+  // ratio to A* -2.0 % at random N = 200, -2.3 % at N = 400, -0.6 % at warehouse N = 400;
+  // same routes).
+  const EntityIndex back = came_from_last_window(input, current);
   // The windows of the moves' edges and destinations, a cache miss each when the search
   // first reads them (after a reserve, most are): asked for all at once, so that their
   // misses overlap instead of coming one after another in drive (in-process A/B over 30
@@ -603,10 +617,12 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
   // N = 400). Reading the timelines' per-entity pointer costs no miss: neighbours' entries
   // share lines.
   for (const Traversal::Move& move : moves) {
+    if (move.to == back) continue;
     __builtin_prefetch(input.timelines->newcomer_windows(move.edge).windows().data());
     __builtin_prefetch(input.timelines->newcomer_windows(move.to).windows().data());
   }
   for (const Traversal::Move& move : moves) {
+    if (move.to == back) continue;
     drive(input, index, current, window_end, move, outcome);
   }
 }

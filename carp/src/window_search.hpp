@@ -311,6 +311,11 @@ class WindowSearch {
   void improve(std::uint32_t state, TimeNs entry, TimeNs ready, std::uint32_t parent,
                std::uint32_t arc, TimeNs edge_entry, DurationNs estimate);
   bool completes(const SearchInput& input, const State& state);
+  /// The vertex `state` was reached from over an arc, if the vehicle left it in that
+  /// vertex's last window; kNoEntity otherwise. Driving back there reaches nothing new: the
+  /// vehicle would arrive after the parent state's ready, and the vertex has no window
+  /// after the parent's (those before it ended earlier still).
+  topology::EntityIndex came_from_last_window(const SearchInput& input, const State& state);
   void expand(const SearchInput& input, std::uint32_t index, const State& current,
               SearchOutcome& outcome);
 
