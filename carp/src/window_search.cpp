@@ -37,7 +37,7 @@ void WindowSearch::begin(const SearchInput& input) {
     queried_.assign(entities, QueriedWindows{});
     window_ids_of_.assign(entities, WindowIds{});
   }
-  agent_bits_ = topology::TimelineSet::AgentBits::key(input.agent);
+  mark_own_entities(input);
   const std::size_t blocks = input.legs.size() * graph.vertex_count();
   if (block_stamp_.size() < blocks) {
     block_stamp_.resize(blocks, 0);
@@ -59,6 +59,21 @@ void WindowSearch::begin(const SearchInput& input) {
   shut_in_proofs_ = 0;
   shut_in_refusals_ = 0;
   path_.clear();
+}
+
+void WindowSearch::mark_own_entities(const SearchInput& input) {
+  const std::size_t words = (input.graph->topology().entity_count() + 63) / 64;
+  if (own_entities_.size() != words) {
+    own_entities_.assign(words, 0);
+  } else {
+    for (const EntityIndex entity : own_marked_) own_entities_[entity >> 6] = 0;
+  }
+  own_marked_.clear();
+  for (const EntityIndex entity : input.timelines->reserved_entities(input.agent)) {
+    if (entity >= words * 64) break;  // sorted: none of the graph's from here on
+    own_marked_.push_back(entity);
+    own_entities_[entity >> 6] |= std::uint64_t{1} << (entity & 63);
+  }
 }
 
 void WindowSearch::query_windows(const SearchInput& input, EntityIndex entity) {

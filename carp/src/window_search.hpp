@@ -207,7 +207,8 @@ class WindowSearch {
   OpenEntry open_entry(TimeNs ready, DurationNs estimate, std::uint32_t state);
   /// The free windows of `entity`, sorted: `count` of them from the pointer returned, which
   /// stays valid during the search. Served in place from the timelines' newcomer view when
-  /// every reservation there blocks the agent (most entities): then they begin with those
+  /// every reservation there blocks the agent (where it has none: most entities, told by a
+  /// bit of own_entities_): then they begin with those
   /// that ended by the start time, and the first after it may start before it (the search
   /// never gets there before it, and every reader takes a window start as "free from", so
   /// that start only weakens bounds). Otherwise from an exact query, from the start time on.
@@ -217,10 +218,9 @@ class WindowSearch {
   /// first).
   const topology::Interval* windows_of(const SearchInput& input, topology::EntityIndex entity,
                                        std::uint32_t& count) {
-    const topology::TimelineSet::NewcomerWindows& newcomer =
-        input.timelines->newcomer_windows(entity);
-    if (input.count_locks && !newcomer.agents().may_contain(agent_bits_)) [[likely]] {
-      const std::span<const topology::Interval> windows = newcomer.windows();
+    if (input.count_locks && !own_entity(entity)) [[likely]] {
+      const std::span<const topology::Interval> windows =
+          input.timelines->newcomer_windows(entity).windows();
       count = static_cast<std::uint32_t>(windows.size());
       return windows.data();
     }
@@ -338,7 +338,19 @@ class WindowSearch {
   // The windows of exact queries (see windows_of).
   WindowStore own_windows_;
   std::vector<topology::Interval> scratch_;  // an exact query's answer, before it is stored
-  topology::TimelineSet::AgentBits::Key agent_bits_;  // of the search's agent
+  /// Whether the search's agent has a reservation on `entity` (see mark_own_entities).
+  bool own_entity(topology::EntityIndex entity) const {
+    return (own_entities_[entity >> 6] >> (entity & 63) & 1) != 0;
+  }
+  /// Sets the bits of own_entities_ for the entities where the search's agent has
+  /// reservations (clearing the last search's). A bit per entity stays in L1, where the
+  /// per-entity filter the timelines kept before shared a cache line with the first
+  /// windows of each block and pushed the third and fourth onto another (bench plan,
+  /// callgrind, planner: L2 misses -11 % at random N = 200, -15 % at N = 400 and -14 % at
+  /// warehouse N = 400, instructions -5 %).
+  void mark_own_entities(const SearchInput& input);
+  std::vector<std::uint64_t> own_entities_;       // a bit per entity
+  std::vector<topology::EntityIndex> own_marked_;  // whose bits are set
   std::vector<State> states_;
   DivingMinHeap<OpenEntry> open_;
   /// The label of a state of prove_late's backward search: the latest time the vehicle may

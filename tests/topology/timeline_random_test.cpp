@@ -391,17 +391,21 @@ class RandomRun {
     last_ = "free_windows " + agent + " " + std::to_string(entity);
     const auto got = set_.free_windows(entity, agent, from, until);
     EXPECT_EQ(got, ref_.free_windows(entity, agent, from, until));
-    // A newcomer's windows (what planners keep between plans) after every kind of change,
-    // and the agents said to have reservations there: all of them.
+    // A newcomer's windows (what planners keep between plans) after every kind of change.
     const auto view = set_.newcomer_windows(entity);
     std::vector<Interval> newcomer;  // the view from `from` on, as a planner reads it
     for (const Interval& w : view.windows()) {
       if (w.end > from) newcomer.push_back(Interval{std::max(w.start, from), w.end});
     }
     EXPECT_EQ(newcomer, ref_.free_windows(entity, "newcomer", from, kForever));
-    for (const Reservation& r : set_.timeline(entity).reservations) {
-      EXPECT_TRUE(view.agents().may_contain(TimelineSet::AgentBits::key(r.agent))) << r.agent;
-    }
+    // Where the view is not an agent's (reserved_entities): exactly where it has some.
+    const auto reserved = set_.reserved_entities(agent);
+    EXPECT_TRUE(std::is_sorted(reserved.begin(), reserved.end()));
+    const auto& here = set_.timeline(entity).reservations;
+    EXPECT_EQ(std::binary_search(reserved.begin(), reserved.end(), entity),
+              std::any_of(here.begin(), here.end(),
+                          [&](const Reservation& r) { return r.agent == agent; }))
+        << agent << " on " << entity;
     for (std::size_t i = 0; i < got.size(); ++i) {  // sorted, disjoint, maximal, inside
       EXPECT_TRUE(got[i].valid());
       EXPECT_GE(got[i].start, from);

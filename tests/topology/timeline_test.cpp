@@ -376,45 +376,34 @@ TEST_F(TimelineTest, NewcomerWindowsAreThoseOfAnAgentWithoutReservationsThere) {
             (std::vector<Interval>{{20, 30}, {40, kForever}}));
   EXPECT_EQ(set.free_windows(0, "bob", 5, kForever),
             (std::vector<Interval>{{5, 10}, {20, 30}, {40, kForever}}));
-  TimelineSet::AgentBits amy;
-  amy.add(TimelineSet::AgentBits::key("amy"));
-  EXPECT_EQ(view.agents(), amy);
-  EXPECT_TRUE(view.agents().may_contain(TimelineSet::AgentBits::key("amy")));
   EXPECT_TRUE(set.newcomer_windows(99).windows().empty());  // not an entity of the set
 }
 
-TEST(AgentBits, FleetIdsSpreadOverTheBits) {
-  // Ids that differ only in their last digits, as a fleet's do, must not crowd a few bits:
-  // a planner makes an exact query for every entity where its bits are taken.
-  std::vector<int> count(256, 0);
-  int same = 0;
-  for (int i = 0; i < 400; ++i) {
-    const TimelineSet::AgentBits::Key key =
-        TimelineSet::AgentBits::key("agent-" + std::to_string(i));
-    ++count[key.first];
-    ++count[key.second];
-    same += key.first == key.second;
-  }
-  const int used = static_cast<int>(std::count_if(count.begin(), count.end(), [](int c) { return c > 0; }));
-  EXPECT_GE(used, 235);  // 800 bits thrown at random into 256 fill about 245
-  EXPECT_LE(*std::max_element(count.begin(), count.end()), 10);
-  EXPECT_LE(same, 5);  // an agent whose two bits coincide has one: about 1.6 in 400
+std::vector<EntityIndex> entities(std::span<const EntityIndex> span) {
+  return {span.begin(), span.end()};
 }
 
-TEST(AgentBits, ABusyEntityRarelySuspectsANewcomer) {
-  // Twenty agents hold a busy entity; of a thousand others, the filter may suspect a few
-  // (each an exact query for a planner), but never misses one of the twenty.
-  TimelineSet::AgentBits bits;
-  for (int i = 0; i < 20; ++i) bits.add(TimelineSet::AgentBits::key("agv-" + std::to_string(i)));
-  for (int i = 0; i < 20; ++i) {
-    EXPECT_TRUE(bits.may_contain(TimelineSet::AgentBits::key("agv-" + std::to_string(i))));
-  }
-  int suspected = 0;
-  for (int i = 0; i < 1000; ++i) {
-    suspected += bits.may_contain(TimelineSet::AgentBits::key("agv-" + std::to_string(1000 + i)));
-  }
-  // Two bits an agent: about 2 %, 21 of 1000 (one bit an agent: about 7.5 %, 75).
-  EXPECT_LE(suspected, 30);
+TEST_F(TimelineTest, ReservedEntitiesAreExactlyWhereAnAgentHasReservations) {
+  EXPECT_TRUE(set.reserved_entities("amy").empty());
+  // A real reservation on 0 and its shadow on 1; then a second route on 1 and one on 2.
+  ASSERT_TRUE(set.reserve("amy", 1, {at(0, 10, 20)}));
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1}));
+  ASSERT_TRUE(set.reserve("amy", 2, {at(2, 30, 40), at(1, 39, 50)}));
+  ASSERT_TRUE(set.reserve("bob", 1, {at(3, 0, 5)}));
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1, 2}));
+  EXPECT_EQ(entities(set.reserved_entities("bob")), (std::vector<EntityIndex>{3}));
+  EXPECT_TRUE(set.reserved_entities("am").empty());  // no prefix matches
+  // Cancelling the first route leaves 1 (the second route's, and its shadow on 0).
+  ASSERT_TRUE(set.cancel_route("amy", 1));
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1, 2}));
+  ASSERT_TRUE(set.cancel_route("amy", 2));
+  EXPECT_TRUE(set.reserved_entities("amy").empty());
+  EXPECT_EQ(entities(set.reserved_entities("bob")), (std::vector<EntityIndex>{3}));
+  // A copy answers alike, and a newcomer sees every entity's windows as its own.
+  const TimelineSet copy = set;
+  EXPECT_EQ(entities(copy.reserved_entities("bob")), (std::vector<EntityIndex>{3}));
+  EXPECT_EQ(copy.free_windows(3, "bob", 0, kForever), windows({{0, kForever}}));
+  EXPECT_EQ(copy.free_windows(3, "cat", 0, kForever), windows({{5, kForever}}));
 }
 
 TEST_F(TimelineTest, WindowsRevisionsMoveWhenWhatFreeWindowsReadChanges) {

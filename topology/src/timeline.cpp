@@ -113,7 +113,8 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
       revisions_{std::vector<std::uint64_t>(conflict_sets_.size())},
-      newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size()), {}} {
+      newcomers_{std::vector<NewcomerWindows>(conflict_sets_.size()), {}, {},
+                 std::vector<std::vector<std::uint32_t>>(conflict_sets_.size()), {}, {}} {
   Impl::revise_all(*this);
 }
 

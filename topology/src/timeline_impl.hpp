@@ -47,11 +47,20 @@ struct TimelineSet::Impl {
   /// The same on a newcomer's windows.
   static void cut_window(NewcomerWindows& windows, Interval cut);
   /// Whether admit would accept `item` on its timeline without reading the reservations:
-  /// its agent has none there (`agent` is its AgentBits key) and its window lies within one
-  /// of the newcomer's windows, which every reservation, holder and lock there (and the
-  /// locks on the conflict set) keep clear. False says nothing.
+  /// its agent has none there (`agent_entities`: its reserved_entities) and its window lies
+  /// within one of the newcomer's windows, which every reservation, holder and lock there
+  /// (and the locks on the conflict set) keep clear. False says nothing.
   static bool clear_for_newcomer(const TimelineSet& set, const Reservation& item,
-                                 AgentBits::Key agent);
+                                 std::span<const EntityIndex> agent_entities);
+  // Who has a reservation where (reserved_entities.cpp).
+  /// The number of `agent` in the index, given one if it has none yet.
+  static std::uint32_t agent_number(TimelineSet& set, std::string_view agent);
+  /// Records that agent number `agent` has a reservation on `entity`.
+  static void add_reserver(TimelineSet& set, EntityIndex entity, std::uint32_t agent);
+  /// Finds the agents with a reservation on `entity` again, from its timeline.
+  static void find_reservers(TimelineSet& set, EntityIndex entity);
+  /// Whether `entity` is among `agent_entities` (an agent's reserved_entities).
+  static bool has_reservation(std::span<const EntityIndex> agent_entities, EntityIndex entity);
   /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.
   template <class Skip>
   static void sweep(const TimelineSet& set, EntityIndex entity, TimeNs from, TimeNs until,

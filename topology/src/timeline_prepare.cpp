@@ -128,14 +128,14 @@ Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reserv
                       std::to_string(ev.version));
     }
   }
-  const AgentBits::Key agent = AgentBits::key(items.front().agent);
+  const std::span<const EntityIndex> agent_entities = set.reserved_entities(items.front().agent);
   for (std::size_t i = 0; i < items.size(); ++i) {
     const Reservation& item = items[i];
     // Most items of a planned route lie in a window a newcomer sees: then none of the
     // checks below can fail, and the reservations (72 bytes each, hundreds per route) need
     // not be read (bench plan, random N = 200: they were a third of reserve's memory
     // traffic, which left the planner's data out of the cache).
-    if (clear_for_newcomer(set, item, agent)) continue;
+    if (clear_for_newcomer(set, item, agent_entities)) continue;
     const Timeline& t = set.timelines_[item.entity];
     const auto where = [&] { return op + ": " + item_text(i, item); };  // only for an error
     for (const Reservation& r : t.reservations) {
@@ -174,6 +174,7 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
   // of a route cost reserve 2 % more instructions.
   std::vector<EntityIndex> entities;
   entities.reserve(items.size());
+  const std::uint32_t agent = agent_number(set, items.front().agent);  // one agent (admit)
   for (const Reservation& item : items) {
     // Each item goes where timeline order puts it (a route adds one or a few items to a
     // timeline of many: cheaper than sorting the timeline again).
@@ -189,9 +190,8 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
     if (is_held(set, added)) {
       revise(set, item.entity, set.revisions_.of[item.entity]);
     } else {
-      NewcomerWindows& newcomer = set.newcomers_.of[item.entity];
-      newcomer.add_agent(AgentBits::key(item.agent));
-      cut_window(newcomer, item.window);
+      add_reserver(set, item.entity, agent);
+      cut_window(set.newcomers_.of[item.entity], item.window);
     }
   }
   touched.insert(entities.begin(), entities.end());

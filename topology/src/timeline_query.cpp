@@ -69,9 +69,9 @@ void TimelineSet::Impl::cut_window(NewcomerWindows& windows, Interval cut) {
 }
 
 bool TimelineSet::Impl::clear_for_newcomer(const TimelineSet& set, const Reservation& item,
-                                           AgentBits::Key agent) {
+                                           std::span<const EntityIndex> agent_entities) {
+  if (has_reservation(agent_entities, item.entity)) return false;
   const NewcomerWindows& newcomer = set.newcomers_.of[item.entity];
-  if (newcomer.agents().may_contain(agent)) return false;
   const std::span<const Interval> windows = newcomer.windows();
   const auto window = std::partition_point(
       windows.begin(), windows.end(), [&](const Interval& w) { return w.end <= item.window.start; });
@@ -119,9 +119,8 @@ void TimelineSet::append_free_windows(EntityIndex entity, std::string_view agent
   // (a holder starting by then only drops windows that end before it), without reading
   // the reservations. A planner asks this for every start and goal it checks.
   if (count_locks && owns(entity) && from < until) {
-    const NewcomerWindows& newcomer = newcomers_.of[entity];
-    if (!newcomer.agents().may_contain(AgentBits::key(agent))) {
-      for (const Interval& w : newcomer.windows()) {
+    if (!Impl::has_reservation(reserved_entities(agent), entity)) {
+      for (const Interval& w : newcomers_.of[entity].windows()) {
         if (w.end <= from) continue;
         if (w.start >= until) break;
         out.push_back(Interval{std::max(w.start, from), std::min(w.end, until)});
@@ -140,11 +139,9 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
   windows.clear();
   newcomer.clear();
   sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, windows, true,
-        [&newcomer](const Reservation& r) {
-          newcomer.add_agent(AgentBits::key(r.agent));
-          return false;
-        });
+        [](const Reservation&) { return false; });
   newcomer.assign(windows);
+  find_reservers(set, entity);
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

@@ -24,14 +24,13 @@
 // No DDS here: a topology agent wraps one TimelineSet (the entities it owns) and the
 // routing agent keeps a replica for planning.
 
-#include <array>
 #include <cstdint>
-#include <cstring>
 #include <map>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "drover/common/clock.hpp"
@@ -242,62 +241,17 @@ class TimelineSet {
   void append_free_windows(EntityIndex entity, std::string_view agent, TimeNs from,
                            TimeNs until, std::vector<Interval>& out,
                            bool count_locks = true) const;
-  /// The agents with a reservation on an entity, as a Bloom filter of 256 bits, two per
-  /// agent: an agent whose two bits are not both set surely has none there; one whose bits
-  /// are may (a false "may" only costs a planner an exact query, which sweeps the timeline
-  /// and its conflict set: tens of cache misses). 256, not 64: with hundreds of agents,
-  /// busy entities would otherwise have most bits set (bench plan, warehouse N = 400: 3 %
-  /// of the planner's instructions went to exact queries with 64 bits). Two bits, not one:
-  /// on an entity that 20 agents use, a newcomer is falsely suspected about 2 % of the
-  /// time rather than 7.5 % (bench plan: 68 exact queries instead of 595 at random
-  /// N = 200, 662 instead of 6 520 at warehouse N = 400).
-  class AgentBits {
-   public:
-    /// Where an agent's two bits are.
-    struct Key {
-      std::uint8_t first = 0;
-      std::uint8_t second = 0;
-    };
-    /// The bits of `agent`. Inline: it runs for every reservation a planner reads.
-    static Key key(std::string_view agent) noexcept {
-      // Hashes the last 8 bytes and the length only: fleet ids differ at their ends
-      // ("agv-017"). A multiply, then a xor-shift and a multiply of the murmur3 finalizer,
-      // so that the two bytes taken are both well mixed.
-      std::uint64_t tail = 0;
-      if (agent.size() >= sizeof tail) {  // a load of fixed size, not a call
-        std::memcpy(&tail, agent.data() + agent.size() - sizeof tail, sizeof tail);
-      } else if (!agent.empty()) {
-        std::memcpy(&tail, agent.data(), agent.size());
-      }
-      std::uint64_t h = (tail ^ agent.size()) * 0x9e3779b97f4a7c15ull;
-      h ^= h >> 33;
-      h *= 0xff51afd7ed558ccdull;
-      return Key{static_cast<std::uint8_t>(h >> 56), static_cast<std::uint8_t>(h >> 48)};
-    }
-    void add(Key key) noexcept {
-      words_[key.first >> 6] |= std::uint64_t{1} << (key.first & 63);
-      words_[key.second >> 6] |= std::uint64_t{1} << (key.second & 63);
-    }
-    bool may_contain(Key key) const noexcept {
-      return (words_[key.first >> 6] >> (key.first & 63) &
-              words_[key.second >> 6] >> (key.second & 63) & 1) != 0;
-    }
-    friend bool operator==(const AgentBits&, const AgentBits&) = default;
-
-   private:
-    std::array<std::uint64_t, 4> words_{};
-  };
   /// The windows of an agent with no reservation on an entity (every reservation there
   /// blocks) from the beginning of time: append_free_windows(entity, agent, from, kForever,
   /// out) appends those that end after `from`, the first starting at `from` at the
-  /// earliest. And the agents with a reservation there: for an agent not in it, these are
-  /// its windows.
+  /// earliest. They are an agent's windows unless the entity is among its
+  /// reserved_entities.
   ///
   /// Laid out for a planner, which reads them for every entity it touches, mostly missing
-  /// the cache: the agents and the windows of an entity share one block, aligned to a cache
-  /// line, the agents first and the first two windows on the same line (bench plan,
-  /// random-32-32-20: half the entities have at most three windows). Only a pointer and the
-  /// count live in the set's array, which stays in cache. Changed by the set only.
+  /// the cache: the windows of an entity fill a block aligned to a cache line, four to a
+  /// line (bench plan, random-32-32-20: half the entities have at most three windows).
+  /// Only a pointer and the count live in the set's array, which stays in cache. Changed
+  /// by the set only.
   class NewcomerWindows {
    public:
     NewcomerWindows() noexcept = default;
@@ -309,40 +263,27 @@ class TimelineSet {
     }
     ~NewcomerWindows();
 
-    /// The agents with a reservation on the entity (see AgentBits).
-    const AgentBits& agents() const noexcept { return *block_; }
     /// The windows, sorted and disjoint, the first starting before any time asked for.
-    std::span<const Interval> windows() const noexcept { return {first(), size_}; }
+    std::span<const Interval> windows() const noexcept { return {windows_, size_}; }
 
    private:
     friend struct TimelineSet::Impl;
-    static constexpr std::size_t kLine = 64;
-    /// The windows follow the agents in the block.
-    const Interval* first() const noexcept {
-      return reinterpret_cast<const Interval*>(block_ + 1);
-    }
-    Interval* first() noexcept { return reinterpret_cast<Interval*>(block_ + 1); }
     void swap(NewcomerWindows& other) noexcept {
-      std::swap(block_, other.block_);
+      std::swap(windows_, other.windows_);
       std::swap(size_, other.size_);
       std::swap(capacity_, other.capacity_);
     }
-    /// No windows, no agents.
-    void clear() noexcept;
-    void add_agent(AgentBits::Key key);
+    void clear() noexcept { size_ = 0; }
     void assign(std::span<const Interval> windows);
     /// Replaces windows [first, last) by `pieces`.
     void replace(std::size_t first, std::size_t last, std::span<const Interval> pieces);
-    /// Makes room for `capacity` windows, keeping the agents and windows; the block is
-    /// the set's own after (never the shared empty one).
+    /// Makes room for `capacity` windows, keeping the windows.
     void reserve(std::size_t capacity);
 
-    // The block: the agents, then capacity_ windows; while capacity_ is 0, a shared empty
-    // block that is never written.
-    AgentBits* block_ = const_cast<AgentBits*>(&kNoAgents);
+    // capacity_ windows, in whole cache lines (none while capacity_ is 0).
+    Interval* windows_ = nullptr;
     std::uint32_t size_ = 0;
     std::uint32_t capacity_ = 0;
-    alignas(kLine) static const AgentBits kNoAgents;
   };
   /// \return those of `entity`, kept by the set (recomputed whenever the entity's windows
   ///         revision moves): valid until the set changes. Empty for an entity not owned.
@@ -350,6 +291,12 @@ class TimelineSet {
   const NewcomerWindows& newcomer_windows(EntityIndex entity) const noexcept {
     return entity < newcomers_.of.size() ? newcomers_.of[entity] : kNoNewcomerWindows;
   }
+  /// The entities on whose timelines `agent` has a reservation (real or shadow, prepared
+  /// or committed), sorted: where its free windows may differ from newcomer_windows. Exact
+  /// (a planner marks them once per search, then tells its own entities from the others by
+  /// a bit, where a per-entity filter cost a cache line in every block of windows). Valid
+  /// until the set changes; empty for an agent with none.
+  std::span<const EntityIndex> reserved_entities(std::string_view agent) const noexcept;
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
   /// allocation of a reservation's origin). Equal revisions of an entity, on this set or
@@ -539,6 +486,18 @@ class TimelineSet {
   struct Newcomers {
     std::vector<NewcomerWindows> of;
     std::vector<Interval> scratch;  // a sweep's windows, before they are stored
+    // Who has a reservation where (see reserved_entities), kept with the windows: agents
+    // by number, in the order first seen.
+    struct AgentHash {
+      using is_transparent = void;
+      std::size_t operator()(std::string_view agent) const noexcept {
+        return std::hash<std::string_view>{}(agent);
+      }
+    };
+    std::unordered_map<AgentId, std::uint32_t, AgentHash, std::equal_to<>> numbers;
+    std::vector<std::vector<std::uint32_t>> agents_of;    // per entity: numbers, sorted
+    std::vector<std::vector<EntityIndex>> entities_of;    // per number: entities, sorted
+    std::vector<std::uint32_t> scratch_agents;  // a sweep's agents, before they are stored
     friend bool operator==(const Newcomers&, const Newcomers&) { return true; }
   };
   Newcomers newcomers_;
