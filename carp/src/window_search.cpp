@@ -62,7 +62,8 @@ void WindowSearch::begin(const SearchInput& input) {
 }
 
 void WindowSearch::mark_own_entities(const SearchInput& input) {
-  const std::size_t words = (input.graph->topology().entity_count() + 63) / 64;
+  const std::size_t entities = input.graph->topology().entity_count();
+  const std::size_t words = (entities + 63) / 64;
   if (own_entities_.size() != words) {
     own_entities_.assign(words, 0);
   } else {
@@ -70,7 +71,7 @@ void WindowSearch::mark_own_entities(const SearchInput& input) {
   }
   own_marked_.clear();
   for (const EntityIndex entity : input.timelines->reserved_entities(input.agent)) {
-    if (entity >= words * 64) break;  // sorted: none of the graph's from here on
+    if (entity >= entities) break;  // sorted: none of the graph's from here on
     own_marked_.push_back(entity);
     own_entities_[entity >> 6] |= std::uint64_t{1} << (entity & 63);
   }

@@ -208,8 +208,8 @@ class WindowSearch {
   /// The free windows of `entity`, sorted: `count` of them from the pointer returned, which
   /// stays valid during the search. Served in place from the timelines' newcomer view when
   /// every reservation there blocks the agent (where it has none: most entities, told by a
-  /// bit of own_entities_): then they begin with those
-  /// that ended by the start time, and the first after it may start before it (the search
+  /// bit of own_entities_): then they begin with those that ended by the start time, and
+  /// the first after it may start before it (the search
   /// never gets there before it, and every reader takes a window start as "free from", so
   /// that start only weakens bounds). Otherwise from an exact query, from the start time on.
   /// Inline: no record of the search's own stands between it and the timelines (bench plan,
@@ -267,8 +267,8 @@ class WindowSearch {
     }
     return ids.first + window;
   }
-  /// Storage for the windows a search reads by exact query (where its own agent may have
-  /// reservations): blocks that never move, so that the search may hold pointers into
+  /// Storage for the windows a search reads by exact query (where its own agent has
+  /// reservations, or locks are ignored): blocks that never move, so that the search may hold pointers into
   /// them while it reads more. Reused between searches.
   class WindowStore {
    public:
@@ -343,11 +343,8 @@ class WindowSearch {
     return (own_entities_[entity >> 6] >> (entity & 63) & 1) != 0;
   }
   /// Sets the bits of own_entities_ for the entities where the search's agent has
-  /// reservations (clearing the last search's). A bit per entity stays in L1, where the
-  /// per-entity filter the timelines kept before shared a cache line with the first
-  /// windows of each block and pushed the third and fourth onto another (bench plan,
-  /// callgrind, planner: L2 misses -11 % at random N = 200, -15 % at N = 400 and -14 % at
-  /// warehouse N = 400, instructions -5 %).
+  /// reservations (clearing the last search's): a bit per entity stays in L1, so telling
+  /// those entities from the others costs no read of the timelines (docs/carp.md).
   void mark_own_entities(const SearchInput& input);
   std::vector<std::uint64_t> own_entities_;       // a bit per entity
   std::vector<topology::EntityIndex> own_marked_;  // whose bits are set

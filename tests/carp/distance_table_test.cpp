@@ -7,6 +7,7 @@
 // search on demand, over the traversal's flat adjacency).
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include <gtest/gtest.h>

@@ -398,14 +398,6 @@ class RandomRun {
       if (w.end > from) newcomer.push_back(Interval{std::max(w.start, from), w.end});
     }
     EXPECT_EQ(newcomer, ref_.free_windows(entity, "newcomer", from, kForever));
-    // Where the view is not an agent's (reserved_entities): exactly where it has some.
-    const auto reserved = set_.reserved_entities(agent);
-    EXPECT_TRUE(std::is_sorted(reserved.begin(), reserved.end()));
-    const auto& here = set_.timeline(entity).reservations;
-    EXPECT_EQ(std::binary_search(reserved.begin(), reserved.end(), entity),
-              std::any_of(here.begin(), here.end(),
-                          [&](const Reservation& r) { return r.agent == agent; }))
-        << agent << " on " << entity;
     for (std::size_t i = 0; i < got.size(); ++i) {  // sorted, disjoint, maximal, inside
       EXPECT_TRUE(got[i].valid());
       EXPECT_GE(got[i].start, from);
@@ -498,10 +490,29 @@ class RandomRun {
       EXPECT_EQ(s.timelines[e], want.timelines[e]) << "timeline " << e;
     }
     EXPECT_TRUE(s.held == want.held) << "the allocated reservations differ from the reference";
+    check_reserved_entities();
     if (shadows_share_a_timeline(s)) ++coverage_.shared_timelines;
     for (const auto& check : {reference::check_exclusive(s), reference::check_allocations(s),
                               reference::check_locks(s, excused_)}) {
       for (const std::string& v : check) ADD_FAILURE() << v;
+    }
+  }
+
+  /// After every operation: each agent's reserved_entities are exactly the entities whose
+  /// timelines hold a reservation of its, strictly increasing (a planner reads every other
+  /// entity's windows from the newcomer's view).
+  void check_reserved_entities() {
+    for (const AgentId& agent : agents_) {
+      std::vector<EntityIndex> want;
+      for (EntityIndex e = 0; e < conflicts_.size(); ++e) {
+        const auto& here = set_.timeline(e).reservations;
+        if (std::any_of(here.begin(), here.end(),
+                        [&](const Reservation& r) { return r.agent == agent; })) {
+          want.push_back(e);
+        }
+      }
+      const auto got = set_.reserved_entities(agent);
+      EXPECT_EQ(std::vector<EntityIndex>(got.begin(), got.end()), want) << agent;
     }
   }
 

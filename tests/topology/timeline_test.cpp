@@ -385,7 +385,8 @@ std::vector<EntityIndex> entities(std::span<const EntityIndex> span) {
 
 TEST_F(TimelineTest, ReservedEntitiesAreExactlyWhereAnAgentHasReservations) {
   EXPECT_TRUE(set.reserved_entities("amy").empty());
-  // A real reservation on 0 and its shadow on 1; then a second route on 1 and one on 2.
+  // A real reservation on 0 and its shadow on 1; then a second route, over 2 and 1 (its
+  // shadow on 0), and bob's on 3.
   ASSERT_TRUE(set.reserve("amy", 1, {at(0, 10, 20)}));
   EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1}));
   ASSERT_TRUE(set.reserve("amy", 2, {at(2, 30, 40), at(1, 39, 50)}));
@@ -404,6 +405,45 @@ TEST_F(TimelineTest, ReservedEntitiesAreExactlyWhereAnAgentHasReservations) {
   EXPECT_EQ(entities(copy.reserved_entities("bob")), (std::vector<EntityIndex>{3}));
   EXPECT_EQ(copy.free_windows(3, "bob", 0, kForever), windows({{0, kForever}}));
   EXPECT_EQ(copy.free_windows(3, "cat", 0, kForever), windows({{5, kForever}}));
+}
+
+TEST_F(TimelineTest, ReservedEntitiesFollowPreparedSetsReplicasAndRestores) {
+  const auto aborted = set.prepare(set.expand("amy", 1, {at(2, 0, 10)}), {}, 50);
+  ASSERT_TRUE(aborted);
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{2}));
+  ASSERT_TRUE(set.abort(*aborted));
+  EXPECT_TRUE(set.reserved_entities("amy").empty());
+  ASSERT_TRUE(set.prepare(set.expand("amy", 2, {at(2, 0, 10)}), {}, 50));
+  EXPECT_EQ(set.expire(50).size(), 1u);
+  EXPECT_TRUE(set.reserved_entities("amy").empty());
+  const auto committed = set.prepare(set.expand("amy", 3, {at(0, 0, 10)}), {}, 50);
+  ASSERT_TRUE(committed && set.commit(*committed));
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1}));
+
+  // A copy changes alone.
+  TimelineSet copy = set;
+  ASSERT_TRUE(copy.cancel_route("amy", 3));
+  EXPECT_TRUE(copy.reserved_entities("amy").empty());
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0, 1}));
+
+  // Restored from a snapshot: the same.
+  const auto restored = TimelineSet::restore(graph(4, {{0, 1}}), {}, set.snapshot());
+  ASSERT_TRUE(restored);
+  EXPECT_EQ(entities(restored->reserved_entities("amy")), (std::vector<EntityIndex>{0, 1}));
+  EXPECT_EQ(restored->free_windows(1, "amy", 0, 20), windows({{0, 20}}));
+  EXPECT_EQ(restored->free_windows(1, "bob", 0, 20), windows({{10, 20}}));
+
+  // A replica's timeline replaced: amy's shadow on 1 gone, bob's reservation come. Each
+  // then sees its own as free there.
+  Timeline one;
+  one.version = 4;
+  one.reservations = {Reservation{"bob", 4, 0, 1, 1, {0, 5}, false}};
+  ASSERT_TRUE(set.replace_timeline(1, one));
+  EXPECT_EQ(entities(set.reserved_entities("amy")), (std::vector<EntityIndex>{0}));
+  EXPECT_EQ(entities(set.reserved_entities("bob")), (std::vector<EntityIndex>{1}));
+  EXPECT_EQ(set.free_windows(1, "bob", 0, 10), windows({{0, 10}}));
+  EXPECT_EQ(set.free_windows(1, "amy", 0, 10), windows({{5, 10}}));
+  EXPECT_EQ(set.free_windows(0, "amy", 0, 10), windows({{0, 10}}));
 }
 
 TEST_F(TimelineTest, WindowsRevisionsMoveWhenWhatFreeWindowsReadChanges) {

@@ -55,10 +55,13 @@ struct TimelineSet::Impl {
   // Who has a reservation where (reserved_entities.cpp).
   /// The number of `agent` in the index, given one if it has none yet.
   static std::uint32_t agent_number(TimelineSet& set, std::string_view agent);
-  /// Records that agent number `agent` has a reservation on `entity`.
-  static void add_reserver(TimelineSet& set, EntityIndex entity, std::uint32_t agent);
-  /// Finds the agents with a reservation on `entity` again, from its timeline.
-  static void find_reservers(TimelineSet& set, EntityIndex entity);
+  /// Records that agent number `agent` has reservations on `entities` (sorted in place).
+  static void add_reservers(TimelineSet& set, std::uint32_t agent,
+                            std::vector<EntityIndex>& entities);
+  /// Records that `agents` (numbers, sorted in place) are those with a reservation on
+  /// `entity`.
+  static void set_reservers(TimelineSet& set, EntityIndex entity,
+                            std::vector<std::uint32_t>& agents);
   /// Whether `entity` is among `agent_entities` (an agent's reserved_entities).
   static bool has_reservation(std::span<const EntityIndex> agent_entities, EntityIndex entity);
   /// The free-window sweep of append_free_windows; `skip(r)` leaves out reservation r.

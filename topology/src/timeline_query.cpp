@@ -138,10 +138,17 @@ void TimelineSet::Impl::revise(TimelineSet& set, EntityIndex entity, std::uint64
   std::vector<Interval>& windows = set.newcomers_.scratch;
   windows.clear();
   newcomer.clear();
+  std::vector<std::uint32_t>& agents = set.newcomers_.scratch_agents;
+  agents.clear();
+  const AgentId* last = nullptr;  // a timeline often holds several of one agent's items
   sweep(set, entity, std::numeric_limits<TimeNs>::min(), kForever, windows, true,
-        [](const Reservation&) { return false; });
+        [&](const Reservation& r) {
+          if (last == nullptr || *last != r.agent) agents.push_back(agent_number(set, r.agent));
+          last = &r.agent;
+          return false;
+        });
   newcomer.assign(windows);
-  find_reservers(set, entity);
+  set_reservers(set, entity, agents);
 }
 
 std::uint64_t TimelineSet::windows_revision(EntityIndex entity) const noexcept {

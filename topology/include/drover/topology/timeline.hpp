@@ -25,6 +25,7 @@
 // routing agent keeps a replica for planning.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -292,10 +293,10 @@ class TimelineSet {
     return entity < newcomers_.of.size() ? newcomers_.of[entity] : kNoNewcomerWindows;
   }
   /// The entities on whose timelines `agent` has a reservation (real or shadow, prepared
-  /// or committed), sorted: where its free windows may differ from newcomer_windows. Exact
-  /// (a planner marks them once per search, then tells its own entities from the others by
-  /// a bit, where a per-entity filter cost a cache line in every block of windows). Valid
-  /// until the set changes; empty for an agent with none.
+  /// or committed), sorted: where its free windows may differ from newcomer_windows.
+  /// Exact, kept with the newcomer windows, so that a planner can tell the entities whose
+  /// views it may read once per search instead of once per read. Valid until the set
+  /// changes; empty for an agent with none.
   std::span<const EntityIndex> reserved_entities(std::string_view agent) const noexcept;
   /// Changes, to a value never returned before in this process for any set, whenever the
   /// free windows of `entity` may change (its timeline, a lock on its conflict set, an
