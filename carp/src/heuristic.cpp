@@ -52,7 +52,9 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
       // Backwards: the arcs into top lead from the vertices that can reach it.
       for (const Traversal::Hop& hop : adjacency.into_of(top)) relax(hop.from, distance + hop.travel);
     } else {  // a root the vehicle may not use leads nowhere (it has no moves)
-      for (const Traversal::Move& move : adjacency.out_of(top)) relax(move.to, distance + move.travel);
+      for (const Traversal::Move& move : adjacency.out_of(top)) {
+        relax(move.to, distance + adjacency.timing(move).travel);
+      }
     }
     if (top == vertex) return distance;
   }

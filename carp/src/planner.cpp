@@ -290,7 +290,7 @@ struct Planner::Impl {
           // Moves towards vertices that cannot reach the stop are skipped before the sum
           // (kUnreachable plus a travel time overflows).
           const DurationNs rest = table.distance(*graph, traversal, m.to);
-          return rest != kUnreachable && m.travel + rest == to_go;
+          return rest != kUnreachable && traversal.travel(m.arc) + rest == to_go;
         });
         if (next == moves.end()) break;  // never: prepare_legs found the stop reachable
         at = next->to;

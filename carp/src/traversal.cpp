@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace drover::carp {
 
@@ -101,6 +102,7 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
   Adjacency& adjacency = adjacency_;
   adjacency.into_first.assign(n + 1, 0);
   adjacency.out_first.assign(n + 1, 0);
+  std::map<Timing, std::uint32_t> timing_ids;
   for (EntityIndex v = 0; v < n; ++v) {
     adjacency.into_first[v] = static_cast<std::uint32_t>(adjacency.into.size());
     for (const ArcIndex a : graph.arcs_into(v)) {
@@ -115,7 +117,10 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
     for (ArcIndex a = graph.arcs_begin(v); a != graph.arcs_end(v); ++a) {
       if (!usable_arc(a)) continue;
       const Arc& arc = graph.arc(a);
-      adjacency.out.push_back(Move{travel(a), clearance(a), a, arc.edge, arc.to});
+      const Timing timing{travel(a), clearance(a)};
+      const auto id = timing_ids.try_emplace(timing, adjacency.timings.size()).first->second;
+      if (id == adjacency.timings.size()) adjacency.timings.push_back(timing);
+      adjacency.out.push_back(Move{id, a, arc.edge, arc.to});
       adjacency.out_to.push_back(arc.to);
     }
   }

@@ -434,8 +434,9 @@ template <class Arrive>
                                                           TimeNs window_end,
                                                           const Traversal::Move& move,
                                                           Arrive&& arrive) {
-  const DurationNs travel = move.travel;
-  const DurationNs clearance = move.clearance;
+  const Traversal::Timing& timing = input.traversal->adjacency(*input.graph).timing(move);
+  const DurationNs travel = timing.travel;
+  const DurationNs clearance = timing.clearance;
   // The vehicle must be off the vertex, tail included, before its window ends.
   const TimeNs latest_onto_edge = window_end - clearance;
   if (current.ready > latest_onto_edge) return;
