@@ -50,7 +50,9 @@ DurationNs DistanceTable<kDirection>::resume(const RoutingGraph& graph,
     label_[top] = ~distance;
     if constexpr (kDirection == Direction::to_root) {
       // Backwards: the arcs into top lead from the vertices that can reach it.
-      for (const Traversal::Hop& hop : adjacency.into_of(top)) relax(hop.from, distance + hop.travel);
+      for (const Traversal::Hop& hop : adjacency.into_of(top)) {
+        relax(hop.from, distance + adjacency.timing(hop).travel);
+      }
     } else {  // a root the vehicle may not use leads nowhere (it has no moves)
       for (const Traversal::Move& move : adjacency.out_of(top)) {
         relax(move.to, distance + adjacency.timing(move).travel);

@@ -103,12 +103,18 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
   adjacency.into_first.assign(n + 1, 0);
   adjacency.out_first.assign(n + 1, 0);
   std::map<Timing, std::uint32_t> timing_ids;
+  const auto timing_of = [&](ArcIndex a) {
+    const Timing timing{travel(a), clearance(a)};
+    const auto id = timing_ids.try_emplace(timing, adjacency.timings.size()).first->second;
+    if (id == adjacency.timings.size()) adjacency.timings.push_back(timing);
+    return id;
+  };
   for (EntityIndex v = 0; v < n; ++v) {
     adjacency.into_first[v] = static_cast<std::uint32_t>(adjacency.into.size());
     for (const ArcIndex a : graph.arcs_into(v)) {
       const EntityIndex from = graph.arc(a).from;
       if (usable_arc(a) && usable_vertex(from)) {
-        adjacency.into.push_back(Hop{travel(a), from});
+        adjacency.into.push_back(Hop{timing_of(a), from, graph.arc(a).edge, a});
         adjacency.into_from.push_back(from);
       }
     }
@@ -117,10 +123,7 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
     for (ArcIndex a = graph.arcs_begin(v); a != graph.arcs_end(v); ++a) {
       if (!usable_arc(a)) continue;
       const Arc& arc = graph.arc(a);
-      const Timing timing{travel(a), clearance(a)};
-      const auto id = timing_ids.try_emplace(timing, adjacency.timings.size()).first->second;
-      if (id == adjacency.timings.size()) adjacency.timings.push_back(timing);
-      adjacency.out.push_back(Move{id, a, arc.edge, arc.to});
+      adjacency.out.push_back(Move{timing_of(a), a, arc.edge, arc.to});
       adjacency.out_to.push_back(arc.to);
     }
   }

@@ -48,17 +48,19 @@ class Traversal {
 
   const VehicleProfile& vehicle() const noexcept { return vehicle_; }
 
-  /// A usable arc into a vertex from a usable one, as the backward distance search
-  /// follows it.
-  struct Hop {
-    DurationNs travel;
-    topology::EntityIndex from;
-  };
   /// How long a move takes: its travel() and clearance().
   struct Timing {
     DurationNs travel;
     DurationNs clearance;
     friend auto operator<=>(const Timing&, const Timing&) = default;
+  };
+  /// A usable arc into a vertex from a usable one, as the backward searches follow it (the
+  /// heuristic's, the floor proofs'), in 16 bytes as a Move.
+  struct Hop {
+    std::uint32_t timing;  ///< in Adjacency::timings
+    topology::EntityIndex from;
+    topology::EntityIndex edge;
+    ArcIndex arc;
   };
   /// A usable arc out of a usable vertex, with what a search needs to drive it: 16 bytes,
   /// four to a cache line, its times (few distinct pairs on most maps) in a table apart.
@@ -80,6 +82,7 @@ class Traversal {
     std::vector<Move> out;
     std::vector<Timing> timings;  // the distinct times of the moves
     const Timing& timing(const Move& move) const { return timings[move.timing]; }
+    const Timing& timing(const Hop& hop) const { return timings[hop.timing]; }
     // The vertices alone, in the order of `into` and `out`: what a breadth-first search
     // reads (a quarter and a tenth of the bytes).
     std::vector<topology::EntityIndex> into_from, out_to;

@@ -244,8 +244,7 @@ WindowSearch::FloorProof WindowSearch::raise_arrival_floor(const SearchInput& in
 // floor itself against the brute force.
 WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, ProofKind kind,
                                                  TimeNs deadline, std::size_t budget) {
-  const RoutingGraph& graph = *input.graph;
-  const Traversal& traversal = *input.traversal;
+  const Traversal::Adjacency& adjacency = input.traversal->adjacency(*input.graph);
   if (++late_generation_ == 0) {  // wrapped: every stamp could look current
     std::fill(late_stamp_.begin(), late_stamp_.end(), 0);
     late_generation_ = 1;
@@ -308,16 +307,15 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
       continue;
     }
     const Interval into = clipped(window_of(input, top.vertex, top.window));
-    for (const ArcIndex a : graph.arcs_into(top.vertex)) {
-      const EntityIndex from = graph.arc(a).from;
-      if (!traversal.usable_arc(a) || !traversal.usable_vertex(from)) continue;
-      const DurationNs travel = traversal.travel(a);
-      const DurationNs clearance = traversal.clearance(a);
+    for (const Traversal::Hop& hop : adjacency.into_of(top.vertex)) {
+      const EntityIndex from = hop.from;
+      const DurationNs travel = adjacency.timing(hop).travel;
+      const DurationNs clearance = adjacency.timing(hop).clearance;
       const DurationNs from_start = travel_from_start(input, kind, from);
       if (from_start == kUnreachable) continue;  // no route passes there, whatever the deadline
       const TimeNs earliest = input.start_time + from_start;
       std::uint32_t edge_count = 0;
-      const Interval* edge_first = windows_of(input, graph.arc(a).edge, edge_count);
+      const Interval* edge_first = windows_of(input, hop.edge, edge_count);
       // Windows ending before into.start + clearance fail the first check below: skipped.
       for (std::uint32_t i = ending_after(edge_first, edge_count, into.start + clearance - 1);
            i < edge_count; ++i) {
@@ -362,6 +360,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
 bool WindowSearch::last_stop_shut_in(const SearchInput& input) {
   if (!backward_proofs_apply(input)) return false;
   const RoutingGraph& graph = *input.graph;
+  const Traversal::Adjacency& adjacency = input.traversal->adjacency(graph);
   const auto free_for_good = [&](EntityIndex entity) {
     std::uint32_t count = 0;
     const Interval* first = windows_of(input, entity, count);
@@ -372,10 +371,9 @@ bool WindowSearch::last_stop_shut_in(const SearchInput& input) {
   region_queue_.assign(1, stop);
   region_stamp_[stop] = generation_;
   for (std::size_t head = 0; head < region_queue_.size(); ++head) {
-    for (const ArcIndex a : graph.arcs_into(region_queue_[head])) {
-      const EntityIndex from = graph.arc(a).from;
-      if (region_stamp_[from] == generation_ || !input.traversal->usable_arc(a) ||
-          !input.traversal->usable_vertex(from) || !free_for_good(graph.arc(a).edge) ||
+    for (const Traversal::Hop& hop : adjacency.into_of(region_queue_[head])) {
+      const EntityIndex from = hop.from;
+      if (region_stamp_[from] == generation_ || !free_for_good(hop.edge) ||
           !free_for_good(from)) {
         continue;
       }
