@@ -268,8 +268,8 @@ class WindowSearch {
     return ids.first + window;
   }
   /// Storage for the windows a search reads by exact query (where its own agent has
-  /// reservations, or locks are ignored): blocks that never move, so that the search may hold pointers into
-  /// them while it reads more. Reused between searches.
+  /// reservations, or locks are ignored): blocks that never move, so that the search may
+  /// hold pointers into them while it reads more. Reused between searches.
   class WindowStore {
    public:
     void clear() noexcept { block_ = 0, used_ = 0; }

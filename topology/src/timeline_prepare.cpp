@@ -185,8 +185,8 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
     entities.push_back(item.entity);
     // The newcomer's windows lose the item's window, and its agent is among those with a
     // reservation there (add_reservers, below): what revise's sweep would find, without
-    // reading the reservations again. Unless the item is held (never, after admit: its step would be reserved here
-    // already), which blocks everything before it too.
+    // reading the reservations again. Unless the item is held (never, after admit: its
+    // step would be reserved here already), which blocks everything before it too.
     if (is_held(set, added)) {
       revise(set, item.entity, set.revisions_.of[item.entity]);
     } else {
