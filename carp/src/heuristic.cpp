@@ -8,8 +8,11 @@ using topology::EntityIndex;
 
 template <Direction kDirection>
 void DistanceTable<kDirection>::reset(const RoutingGraph& graph, EntityIndex root) {
-  if (label_.size() != graph.vertex_count() || (queued_root_ && fifo_tail_ == 0)) {
-    label_.assign(graph.vertex_count(), kUnreachable);  // new, or after a Dijkstra search
+  if (label_.size() != graph.vertex_count() + 1 || (queued_root_ && fifo_tail_ == 0)) {
+    // New, or after a Dijkstra search. The last label, the padding's (see
+    // Traversal::Adjacency::padded_degree), stays closed.
+    label_.assign(graph.vertex_count() + 1, kUnreachable);
+    label_.back() = ~DurationNs{0};
   } else if (!queued_root_) {
     label_[root_] = kUnreachable;  // never searched: only the root was set
   } else {
@@ -102,13 +105,16 @@ DurationNs DistanceTable<kDirection>::breadth_first(const RoutingGraph& graph,
   // In locals: the label stores could alias the members (same type, but for the sign).
   std::size_t head = fifo_head_, tail = fifo_tail_;
   const bool small = graph.vertex_count() * sizeof(DurationNs) <= kBranchlessBytes;
+  const bool padded = small && adjacency.padded_degree > 0;
   while (label[vertex] >= 0 && head < tail) {
     const EntityIndex top = queue[head++];
     const DurationNs through = ~label[top] + unit;
     // Backwards to the root (the vertices that can reach top), or onwards from it.
-    const std::span<const EntityIndex> next = kDirection == Direction::to_root
-                                                  ? adjacency.sources_of(top)
-                                                  : adjacency.targets_of(top);
+    // Padded, where the branchless loop below runs: it then never leaves early.
+    const std::span<const EntityIndex> next =
+        kDirection == Direction::to_root
+            ? (padded ? adjacency.padded_sources_of(top) : adjacency.sources_of(top))
+            : (padded ? adjacency.padded_targets_of(top) : adjacency.targets_of(top));
     // Every label here is closed (negative) or kUnreachable (not found yet, positive): the
     // sign alone says whether a vertex was found.
     if (small) {

@@ -129,6 +129,23 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
   }
   adjacency.into_first[n] = static_cast<std::uint32_t>(adjacency.into.size());
   adjacency.out_first[n] = static_cast<std::uint32_t>(adjacency.out.size());
+  std::uint32_t degree = 0;
+  for (EntityIndex v = 0; v < n; ++v) {
+    degree = std::max({degree, adjacency.into_first[v + 1] - adjacency.into_first[v],
+                       adjacency.out_first[v + 1] - adjacency.out_first[v]});
+  }
+  if (degree == 0 || degree > Adjacency::kMaxPaddedDegree) return;
+  adjacency.padded_degree = degree;
+  const auto pad = [&](const std::vector<std::uint32_t>& first,
+                       const std::vector<EntityIndex>& vertices, std::vector<EntityIndex>& padded) {
+    padded.assign(std::size_t{n} * degree, static_cast<EntityIndex>(n));
+    for (EntityIndex v = 0; v < n; ++v) {
+      std::copy(vertices.begin() + first[v], vertices.begin() + first[v + 1],
+                padded.begin() + std::size_t{v} * degree);
+    }
+  };
+  pad(adjacency.into_first, adjacency.into_from, adjacency.padded_into_from);
+  pad(adjacency.out_first, adjacency.out_to, adjacency.padded_out_to);
 }
 
 bool Traversal::same_class(const VehicleProfile& a, const VehicleProfile& b) {

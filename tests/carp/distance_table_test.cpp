@@ -108,6 +108,39 @@ TEST(DistanceTable, GivesTheFastestTravelTimeBetweenTheRootAndEveryVertex) {
   EXPECT_GT(compared, 3000);
 }
 
+// A vertex with more arcs than Traversal::Adjacency::kMaxPaddedDegree: the small tables'
+// loop then runs over each vertex's own arcs, unpadded; the same distances.
+TEST(DistanceTable, GivesTheFastestTravelTimesAroundAHubOfManyArcs) {
+  GridBuilder g;
+  g.corridor(12);  // (0,0) .. (11,0), joined in a row
+  g.cell(5, 3);    // the hub, joined to every cell of the row but (11,0), one way to (0,0)
+  for (int x = 1; x < 11; ++x) g.edge(5, 3, x, 0);
+  EdgeOptions one_way;
+  one_way.bidirectional = false;
+  g.edge(0, 0, 5, 3, one_way);
+  const auto topology = g.build();
+  const auto graph = std::make_shared<RoutingGraph>(topology);
+  const VehicleProfile vehicle = unit_vehicle();
+  const Traversal traversal(*graph, vehicle);
+  ASSERT_EQ(traversal.adjacency(*graph).padded_degree, 0u);
+  FreePathSearch reference(graph);
+  HeuristicTable to_table;
+  ReachTable from_table;
+  for (topology::EntityIndex root = 0; root < graph->vertex_count(); ++root) {
+    to_table.reset(*graph, root);
+    from_table.reset(*graph, root);
+    for (topology::EntityIndex v = 0; v < graph->vertex_count(); ++v) {
+      const auto to = reference.find(vehicle, v, root);
+      const auto from = reference.find(vehicle, root, v);
+      ASSERT_EQ(to_table.distance(*graph, traversal, v), to ? to->travel_time : kUnreachable)
+          << topology.id(v) << " to " << topology.id(root);
+      ASSERT_EQ(from_table.distance(*graph, traversal, v),
+                from ? from->travel_time : kUnreachable)
+          << topology.id(root) << " to " << topology.id(v);
+    }
+  }
+}
+
 // Breadth-first tables too large for L1 take a loop of their own (with a branch): the same
 // distances there, asked in random order, the search resumed and reset.
 TEST(DistanceTable, GivesTheFastestTravelTimesOnLargeUniformGridsToo) {
