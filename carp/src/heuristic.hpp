@@ -48,7 +48,9 @@ class DistanceTable {
   /// well within a small L1 data cache (32 KiB), so that the labels stay there. Bench plan
   /// on random-32-32-20 (819 vertices, 6.5 KiB of labels), ten alternating runs: ratio to
   /// A* 3.52 -> 3.36 at N = 200, 3.51 -> 3.18 at N = 400. warehouse-10-20-10-2-1 (5 699
-  /// vertices, 45 KiB) keeps the branch, which was faster there.
+  /// vertices, 45 KiB) keeps the branch, which was faster there. The branchless loop reads
+  /// the padded arc lists (Traversal::Adjacency::padded_degree), so that it runs as often
+  /// for every vertex; the table has one label more, the padding's, which stays closed.
   static constexpr std::size_t kBranchlessBytes = 12 * 1024;
 
   /// The reservation-free travel time between `vertex` and the root (in the table's
