@@ -62,17 +62,11 @@ void WindowSearch::begin(const SearchInput& input) {
 }
 
 void WindowSearch::mark_own_entities(const SearchInput& input) {
+  // Cleared whole: a bit per entity, a few hundred words on the largest benchmark map.
   const std::size_t entities = input.graph->topology().entity_count();
-  const std::size_t words = (entities + 63) / 64;
-  if (own_entities_.size() != words) {
-    own_entities_.assign(words, 0);
-  } else {
-    for (const EntityIndex entity : own_marked_) own_entities_[entity >> 6] = 0;
-  }
-  own_marked_.clear();
+  own_entities_.assign((entities + 63) / 64, 0);
   for (const EntityIndex entity : input.timelines->reserved_entities(input.agent)) {
     if (entity >= entities) break;  // sorted: none of the graph's from here on
-    own_marked_.push_back(entity);
     own_entities_[entity >> 6] |= std::uint64_t{1} << (entity & 63);
   }
 }

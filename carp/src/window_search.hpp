@@ -209,9 +209,8 @@ class WindowSearch {
   /// stays valid during the search. Served in place from the timelines' newcomer view when
   /// every reservation there blocks the agent (where it has none: most entities, told by a
   /// bit of own_entities_): then they begin with those that ended by the start time, and
-  /// the first after it may start before it (the search
-  /// never gets there before it, and every reader takes a window start as "free from", so
-  /// that start only weakens bounds). Otherwise from an exact query, from the start time on.
+  /// the first after it may start before it (the search never gets there before it, and
+  /// every reader takes a window start as "free from", so that start only weakens bounds). Otherwise from an exact query, from the start time on.
   /// Inline: no record of the search's own stands between it and the timelines (bench plan,
   /// in-process A/B over 30 repeats, two runs: ratio to A* -1 to -3 % at random N = 200, -3
   /// to -4 % at N = 400, -2 % at warehouse N = 400, against a stamped record per entity read
@@ -343,11 +342,10 @@ class WindowSearch {
     return (own_entities_[entity >> 6] >> (entity & 63) & 1) != 0;
   }
   /// Sets the bits of own_entities_ for the entities where the search's agent has
-  /// reservations (clearing the last search's): a bit per entity stays in L1, so telling
-  /// those entities from the others costs no read of the timelines (docs/carp.md).
+  /// reservations, and only those: a bit per entity stays in L1, so telling those entities
+  /// from the others costs no read of the timelines (docs/carp.md).
   void mark_own_entities(const SearchInput& input);
-  std::vector<std::uint64_t> own_entities_;       // a bit per entity
-  std::vector<topology::EntityIndex> own_marked_;  // whose bits are set
+  std::vector<std::uint64_t> own_entities_;  // a bit per entity
   std::vector<State> states_;
   DivingMinHeap<OpenEntry> open_;
   /// The label of a state of prove_late's backward search: the latest time the vehicle may
