@@ -102,11 +102,22 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
   Adjacency& adjacency = adjacency_;
   adjacency.into_first.assign(n + 1, 0);
   adjacency.out_first.assign(n + 1, 0);
+  const std::size_t arcs = graph.arc_count();
+  adjacency.into.reserve(arcs);
+  adjacency.into_from.reserve(arcs);
+  adjacency.out.reserve(arcs);
+  adjacency.out_to.reserve(arcs);
   std::map<Timing, std::uint32_t> timing_ids;
+  // Most arcs take the time of the arc before (a grid's all do): that one is asked first.
+  Timing last_timing{-1, -1};
+  std::uint32_t last_id = 0;
   const auto timing_of = [&](ArcIndex a) {
     const Timing timing{travel(a), clearance(a)};
+    if (timing == last_timing) return last_id;
     const auto id = timing_ids.try_emplace(timing, adjacency.timings.size()).first->second;
     if (id == adjacency.timings.size()) adjacency.timings.push_back(timing);
+    last_timing = timing;
+    last_id = id;
     return id;
   };
   for (EntityIndex v = 0; v < n; ++v) {
