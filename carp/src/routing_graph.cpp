@@ -51,8 +51,4 @@ RoutingGraph::RoutingGraph(const topology::Topology& topology) : topology_(&topo
   }
 }
 
-double RoutingGraph::straight_distance(EntityIndex a, EntityIndex b) const {
-  return std::hypot(x_[a] - x_[b], y_[a] - y_[b]);
-}
-
 }  // namespace drover::carp
