@@ -98,12 +98,20 @@ TEST_F(BenchPlan, PrintsOneJsonLineAndWritesEveryAgentsSteps) {
   EXPECT_GT(line["astar_seconds"].get<double>(), 0);
   EXPECT_DOUBLE_EQ(line["ratio_to_astar"].get<double>(),
                    line["plan_seconds"].get<double>() / line["astar_seconds"].get<double>());
+  // The same over the planned agents alone: a part of each repeat's sums.
+  EXPECT_GT(line["planned_astar_seconds"].get<double>(), 0);
+  EXPECT_LE(line["planned_astar_seconds"].get<double>(), line["astar_seconds"].get<double>());
+  EXPECT_LE(line["planned_plan_seconds"].get<double>(), line["plan_seconds"].get<double>());
+  EXPECT_DOUBLE_EQ(line["planned_ratio_to_astar"].get<double>(),
+                   line["planned_plan_seconds"].get<double>() /
+                       line["planned_astar_seconds"].get<double>());
 
   // The paths: one line per agent, from its start at time 0 to its goal held for good.
   const std::vector<std::pair<std::string, std::string>> tasks{
       {"0,0", "5,2"}, {"5,0", "0,2"}, {"2,2", "3,0"}};
   std::istringstream paths(read_all(path("paths.jsonl")));
   double sum_of_costs = 0;
+  double manhattan_sum = 0;  // a lower bound of the planned agents' free travel times
   int planned = 0;
   std::string text;
   for (int agent = 0; agent < 3; ++agent) {
@@ -125,10 +133,20 @@ TEST_F(BenchPlan, PrintsOneJsonLineAndWritesEveryAgentsSteps) {
       EXPECT_GE(steps[i]["enter"].get<double>(), steps[i - 1]["enter"].get<double>());
     }
     sum_of_costs += steps.back()["enter"].get<double>();
+    const auto cell = [](const std::string& id) {
+      const auto comma = id.find(',');
+      return std::pair{std::stoi(id.substr(0, comma)), std::stoi(id.substr(comma + 1))};
+    };
+    const auto [x0, y0] = cell(tasks[agent].first);
+    const auto [x1, y1] = cell(tasks[agent].second);
+    manhattan_sum += std::abs(x1 - x0) + std::abs(y1 - y0);  // 1 m cells at 1 m/s
   }
   EXPECT_FALSE(std::getline(paths, text)) << "one line per agent only";
   EXPECT_EQ(line["planned"], planned);
   EXPECT_DOUBLE_EQ(line["sum_of_costs"].get<double>(), sum_of_costs);
+  // Reservation-free, the same agents arrive no later, and no sooner than in a straight line.
+  EXPECT_LE(line["free_sum_of_costs"].get<double>(), sum_of_costs);
+  EXPECT_GE(line["free_sum_of_costs"].get<double>(), manhattan_sum);
 }
 
 TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
