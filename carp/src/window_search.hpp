@@ -210,7 +210,8 @@ class WindowSearch {
   /// every reservation there blocks the agent (where it has none: most entities, told by a
   /// bit of own_entities_): then they begin with those that ended by the start time, and
   /// the first after it may start before it (the search never gets there before it, and
-  /// every reader takes a window start as "free from", so that start only weakens bounds). Otherwise from an exact query, from the start time on.
+  /// every reader takes a window start as "free from", so that start only weakens bounds).
+  /// Otherwise from an exact query, from the start time on.
   /// Inline: no record of the search's own stands between it and the timelines (bench plan,
   /// in-process A/B over 30 repeats, two runs: ratio to A* -1 to -3 % at random N = 200, -3
   /// to -4 % at N = 400, -2 % at warehouse N = 400, against a stamped record per entity read
