@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <iostream>
 #include <mutex>
 #include <string>
@@ -38,10 +39,12 @@ TEST_F(AgentDirectoryTest, SeesAHeartbeatAndNoticesWhenItsAgentIsKilled) {
   ASSERT_NE(participant, nullptr);
   std::vector<dds::AgentRecord> changes;
   std::mutex changes_mutex;
+  std::condition_variable changed;
   dds::AgentDirectoryOptions options;
   options.on_change = [&](const dds::AgentRecord& record) {
     std::lock_guard lock(changes_mutex);
     changes.push_back(record);
+    changed.notify_all();
   };
   auto directory = dds::AgentDirectory::create(*participant, options);
   ASSERT_TRUE(directory.has_value()) << directory.error().message;
@@ -69,7 +72,14 @@ TEST_F(AgentDirectoryTest, SeesAHeartbeatAndNoticesWhenItsAgentIsKilled) {
   EXPECT_TRUE((*directory)->live_agents().empty());
   std::cout << "kill -9 noticed after " << detection.count() << " ms (" << dead->lost_reason << ")\n";
 
-  directory->reset();  // stops the notifier: `changes` is complete
+  // on_change runs on the directory's notifier thread, which may not have delivered the
+  // death yet; resetting the directory would discard it. Waited for, then the notifier
+  // is stopped so that `changes` no longer moves.
+  {
+    std::unique_lock lock(changes_mutex);
+    changed.wait_for(lock, kDeathBound, [&] { return !changes.empty() && !changes.back().alive; });
+  }
+  directory->reset();
   ASSERT_GE(changes.size(), 2u);
   EXPECT_TRUE(changes.front().alive);
   EXPECT_FALSE(changes.back().alive);
