@@ -201,6 +201,17 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
     agents.push_back(Agent{fmt::format("agent-{}", i), *start, *goal});
   }
 
+  // Opened once the input is checked, before any work: a paths file that cannot be
+  // written is bad input, refused before the run rather than after minutes of it.
+  std::ofstream paths_out;
+  if (!arguments.paths.empty()) {
+    paths_out.open(arguments.paths);
+    if (!paths_out) {
+      std::cerr << "error: " << arguments.paths << ": cannot open the paths file for writing\n";
+      return cli::kExitBadInput;
+    }
+  }
+
   const auto graph = std::make_shared<const carp::RoutingGraph>(map);
   const carp::VehicleProfile vehicle = bench_vehicle(map_options.cell_size);
 
@@ -267,11 +278,9 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
       {"planned_ratio_to_astar",
        planned_astar_seconds > 0 ? planned_plan_seconds / planned_astar_seconds : 0.0},
   };
-  std::cout << line.dump() << "\n";
-
-  if (!arguments.paths.empty()) {
-    std::ofstream out(arguments.paths);
-    for (std::size_t i = 0; i < agents.size() && out; ++i) {
+  // The paths first: the result line is printed only for a run whose output is complete.
+  if (paths_out.is_open()) {
+    for (std::size_t i = 0; i < agents.size() && paths_out; ++i) {
       nlohmann::json path = {{"agent", i}};
       const Outcome& outcome = run.outcomes[i];
       if (outcome.route) {
@@ -281,13 +290,15 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
         path["error"] = fmt::format("{}: {}", carp::to_string(outcome.error->reason),
                                     outcome.error->message);
       }
-      out << path.dump() << "\n";
+      paths_out << path.dump() << "\n";
     }
-    if (!out) {
+    paths_out.flush();
+    if (!paths_out) {
       std::cerr << "error: " << arguments.paths << ": cannot write the paths file\n";
       return cli::kExitFailure;
     }
   }
+  std::cout << line.dump() << "\n";
   return cli::kExitOk;
 }
 

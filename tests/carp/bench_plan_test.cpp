@@ -171,6 +171,10 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
        "--agents: must be > 0, got 0"},
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "two"},
        "--agents: 'two' is not a number"},
+      // Refused before the run: no result line for output that could not be written.
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1", "--paths",
+        path("no-such-dir/paths.jsonl")},
+       path("no-such-dir/paths.jsonl") + ": cannot open the paths file for writing"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.message);
