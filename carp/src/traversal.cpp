@@ -125,7 +125,7 @@ void Traversal::build_adjacency(const RoutingGraph& graph) const {
     for (const ArcIndex a : graph.arcs_into(v)) {
       const EntityIndex from = graph.arc(a).from;
       if (usable_arc(a) && usable_vertex(from)) {
-        adjacency.into.push_back(Hop{timing_of(a), from, graph.arc(a).edge, a});
+        adjacency.into.push_back(Hop{timing_of(a), from, graph.arc(a).edge});
         adjacency.into_from.push_back(from);
       }
     }

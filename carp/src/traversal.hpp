@@ -55,12 +55,11 @@ class Traversal {
     friend auto operator<=>(const Timing&, const Timing&) = default;
   };
   /// A usable arc into a vertex from a usable one, as the backward searches follow it (the
-  /// heuristic's, the floor proofs'), in 16 bytes as a Move.
+  /// heuristic's, the floor proofs', the shut-in check's): what they read, in 12 bytes.
   struct Hop {
     std::uint32_t timing;  ///< in Adjacency::timings
     topology::EntityIndex from;
     topology::EntityIndex edge;
-    ArcIndex arc;
   };
   /// A usable arc out of a usable vertex, with what a search needs to drive it: 16 bytes,
   /// four to a cache line, its times (few distinct pairs on most maps) in a table apart.
