@@ -205,6 +205,18 @@ TEST_F(TimelineTest, RejectionsNameTheItemAndWhatItMeets) {
   items[1].window = Interval{0, 11};
   EXPECT_PRED2(contains, message(items), std::string("item 1 "));
   EXPECT_PRED2(contains, message(items), std::string("its step has origin 0 [0, 10) in item 0"));
+  // Items in any order: a step's first item is the one with the lowest index.
+  items = good;
+  std::reverse(items.begin(), items.end());
+  const std::size_t last = items.size() - 1;  // amy's first item, of step 0
+  const auto first_of_step_0 = static_cast<std::size_t>(
+      std::find_if(items.begin(), items.end(), [](const Reservation& r) { return r.step == 0; }) -
+      items.begin());
+  ASSERT_LT(first_of_step_0, last);  // step 0 has shadows too
+  items[last].window = Interval{0, 11};
+  EXPECT_PRED2(contains, message(items), std::string("item " + std::to_string(last) + " "));
+  EXPECT_PRED2(contains, message(items), std::string("its step has origin 0 [0, 10) in item " +
+                                                     std::to_string(first_of_step_0)));
   // Well formed, but amy's second step meets bob on entity 2.
   EXPECT_PRED2(contains, message(good), std::string("prepare: item "));
   EXPECT_PRED2(contains, message(good), std::string("overlaps agent bob route 1 step 0 [0, 10)"));
