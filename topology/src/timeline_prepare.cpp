@@ -178,6 +178,9 @@ Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reserv
   return {};
 }
 
+/// See insert.
+constexpr std::size_t kFirstReservations = 8;
+
 void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>& items,
                                bool prepared, TouchedSet& touched) {
   // Recorded at once at the end: one by one into the sorted set, the hundreds of entities
@@ -189,6 +192,9 @@ void TimelineSet::Impl::insert(TimelineSet& set, const std::vector<Reservation>&
     // Each item goes where timeline order puts it (a route adds one or a few items to a
     // timeline of many: cheaper than sorting the timeline again).
     std::vector<Reservation>& timeline = set.timelines_[item.entity].reservations;
+    // A timeline that gets reservations gets many (every route over the entity or its
+    // conflict set): room for 8 at once spares the moves of growing through 1, 2 and 4.
+    if (timeline.capacity() == 0) timeline.reserve(kFirstReservations);
     const auto at = std::upper_bound(timeline.begin(), timeline.end(), item, timeline_order);
     Reservation& added = *timeline.insert(at, item);
     added.prepared = prepared;
