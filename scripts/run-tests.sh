@@ -9,4 +9,6 @@ fastdds shm clean >/dev/null 2>&1 || true
 status=0
 ctest --test-dir build --output-on-failure -j"${DROVER_TEST_JOBS:-2}" --timeout 600 || status=$?
 fastdds shm clean >/dev/null 2>&1 || true
+# Then the pure libraries' tests again under AddressSanitizer and UBSan.
+./scripts/run-sanitized-tests.sh || status=1
 exit "$status"
