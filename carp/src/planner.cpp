@@ -94,9 +94,23 @@ void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, st
   // Nobody holds it open-ended when a newcomer can have it for good: most entities.
   const std::span<const Interval> free = timelines.newcomer_windows(entity).windows();
   if (!free.empty() && free.back().end == kForever) return;
-  for (const topology::Reservation& r : timelines.timeline(entity).reservations) {
+  // Every reservation on the timeline blocks a newcomer, so one held open-ended blocks it
+  // from its start on: it starts no earlier than the newcomer's last window ends. Only the
+  // timeline's tail from there is read (sorted by start, and cold), so an explanation costs
+  // log n reads of a long timeline, not n. Bench plan, random N = 400: reading whole
+  // timelines here was a tenth of the planner's last-level misses in callgrind's cache
+  // model; in time, within the noise (in-process A/B: 0.99 to 1.00).
+  const std::vector<topology::Reservation>& reservations =
+      timelines.timeline(entity).reservations;
+  const auto tail =
+      free.empty() ? reservations.begin()
+                   : std::partition_point(reservations.begin(), reservations.end(),
+                                          [from = free.back().end](const topology::Reservation& r) {
+                                            return r.window.start < from;
+                                          });
+  for (auto r = tail; r != reservations.end(); ++r) {
     // The window first: most reservations end, and comparing it is cheaper than the agent.
-    if (r.window.end == kForever && r.agent != agent) holders.push_back(r.agent);
+    if (r->window.end == kForever && r->agent != agent) holders.push_back(r->agent);
   }
 }
 

@@ -214,6 +214,15 @@ TEST(Planner, NamesTheAgentsStandingForGoodInTheWayAsBlockers) {
   EXPECT_EQ(e.reason, PlanFailure::no_window);
   EXPECT_EQ(e.blockers, std::vector<std::string>{"b"}) << e.message;
   EXPECT_NE(e.message.find("standing in the way: b"), std::string::npos) << e.message;
+  // After earlier traffic, from the very end of the last free window: still b, and only b
+  // (the explanation reads the timeline from where the newcomer's windows end).
+  World busy(GridBuilder().corridor(6).build());
+  busy.occupy("d", "2,0", sec(0), sec(1));
+  busy.occupy("b", "2,0", sec(2), kForever);
+  const PlanError after_traffic =
+      plan_error(busy, request_to(busy, "a", "0,0", {open_stop(busy, "4,0")}));
+  EXPECT_EQ(after_traffic.reason, PlanFailure::no_window);
+  EXPECT_EQ(after_traffic.blockers, std::vector<std::string>{"b"}) << after_traffic.message;
   // A stay that ends is no blocker: the route waits for it.
   World later(GridBuilder().corridor(6).build());
   later.occupy("b", "2,0", sec(0), sec(10));
