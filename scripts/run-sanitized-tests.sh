@@ -6,15 +6,9 @@
 # main suite; the build directory is separate, so `build/` keeps its optimised binaries.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-launcher=()
-if command -v ccache >/dev/null; then
-  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
-fi
 tests=(test_topology test_timeline test_carp)
-cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDROVER_SANITIZE=ON \
-  "${launcher[@]}" >/dev/null
-cmake --build build-sanitize -j"${DROVER_JOBS:-2}" --target "${tests[@]}"
+DROVER_BUILD_DIR=build-sanitize DROVER_BUILD_TARGETS="${tests[*]}" \
+  ./scripts/build.sh -DDROVER_SANITIZE=ON
 export DROVER_SOURCE_DIR="$PWD" DROVER_BINARY_DIR="$PWD/build-sanitize"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1
 status=0
