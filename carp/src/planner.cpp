@@ -99,7 +99,7 @@ void add_open_ended_holders(const TimelineSet& timelines, EntityIndex entity, st
   // timeline's tail from there is read (sorted by start, and cold), so an explanation costs
   // log n reads of a long timeline, not n. Bench plan, random N = 400: reading whole
   // timelines here was a tenth of the planner's last-level misses in callgrind's cache
-  // model; in time, within the noise (in-process A/B: 0.99 to 1.00).
+  // model; in time, within the noise (in-process A/B: 0.97 to 1.03).
   const std::vector<topology::Reservation>& reservations =
       timelines.timeline(entity).reservations;
   const auto tail =
