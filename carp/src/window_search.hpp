@@ -233,15 +233,20 @@ class WindowSearch {
   /// ends increase) that ends after `t`; `count` if none does.
   static std::uint32_t ending_after(const topology::Interval* first, std::uint32_t count,
                                     TimeNs t) {
-    if (count <= 8) {  // most entities have a few windows: a scan beats a binary search
-      std::uint32_t i = 0;
-      while (i < count && first[i].end <= t) ++i;
-      return i;
+    // A binary search whose halving is a conditional move: its steps depend on the count
+    // alone, so that only the loop's end can be mispredicted, where a scan (or a branching
+    // binary search) mispredicts where the answer lies, a coin toss per call. In-process
+    // A/B over 30 repeats, two runs, against a scan up to 8 windows and std::partition_point
+    // beyond: ratio to A* -6 to -7 % at random N = 200, -4 to -7 % at N = 400, +-1 % at
+    // warehouse N = 400, though it runs 4 % more planner instructions.
+    if (count == 0) return 0;
+    const topology::Interval* base = first;
+    while (count > 1) {
+      const std::uint32_t half = count / 2;
+      base = base[half].end <= t ? base + half : base;
+      count -= half;
     }
-    return static_cast<std::uint32_t>(
-        std::partition_point(first, first + count,
-                             [t](const topology::Interval& w) { return w.end <= t; }) -
-        first);
+    return static_cast<std::uint32_t>(base - first) + (base->end <= t ? 1 : 0);
   }
   /// Queries the free windows of `entity` for the search's agent from the start time on
   /// (locks counted or not, as the input says), keeps them in own_windows_ and records
