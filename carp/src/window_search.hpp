@@ -327,6 +327,8 @@ class WindowSearch {
   topology::EntityIndex came_from_last_window(const SearchInput& input, const State& state);
   void expand(const SearchInput& input, std::uint32_t index, const State& current,
               SearchOutcome& outcome);
+  /// Asks the cache for the first and the last line of `windows`.
+  static void prefetch_windows(std::span<const topology::Interval> windows);
 
   std::uint32_t generation_ = 0;
   // Per entity queried by this search (see windows_of), valid where stamped with the
