@@ -45,7 +45,7 @@ void WindowSearch::begin(const SearchInput& input) {
   }
   own_windows_.clear();
   window_ids_ = 0;
-  states_.clear();
+  slots_ = 0;
   open_.clear();
   sequence_ = 0;
   arrival_floor_ = 0;
@@ -97,8 +97,7 @@ const Interval* WindowSearch::WindowStore::store(const std::vector<Interval>& wi
   return at;
 }
 
-void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::uint32_t layer,
-                              EntityIndex vertex) {
+void WindowSearch::add_states(const SearchInput& input, std::size_t key, EntityIndex vertex) {
   block_stamp_[key] = generation_;
   std::uint32_t count = 0;
   const Interval* first = windows_of(input, vertex, count);
@@ -106,11 +105,15 @@ void WindowSearch::add_states(const SearchInput& input, std::size_t key, std::ui
   // states for them. The block's index still counts them (unsigned arithmetic wraps back),
   // so that block + window stays the state of that window.
   const std::uint32_t ended = ending_after(first, count, input.start_time);
-  block_first_[key] = static_cast<std::uint32_t>(states_.size()) - ended;
-  for (std::uint32_t i = ended; i < count; ++i) {
-    states_.push_back(State{0, kForever, 0, kNone, kNone, vertex, i,
-                            static_cast<std::uint16_t>(layer), false});
+  block_first_[key] = slots_ - ended;
+  const std::uint32_t end = slots_ + (count - ended);
+  if (end > reached_.size()) {
+    // The states themselves are written when first reached (improve): most never are.
+    reached_.resize(std::max<std::size_t>(end, 2 * reached_.size()));
+    states_.resize(reached_.size());
   }
+  std::fill(reached_.begin() + slots_, reached_.begin() + end, kForever);
+  slots_ = end;
 }
 
 // Inlined, as improve below, into drive's callback (once per state improved): -2 % planner
@@ -401,21 +404,15 @@ WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estima
                    state};
 }
 
-[[gnu::always_inline]] inline void WindowSearch::improve(std::uint32_t state, TimeNs entry,
-                                                        TimeNs ready, std::uint32_t parent,
-                                                        std::uint32_t arc, TimeNs edge_entry,
+[[gnu::always_inline]] inline void WindowSearch::improve(std::uint32_t state,
+                                                        const State& reached,
                                                         DurationNs estimate) {
-  State& s = states_[state];
-  if (ready >= s.ready) return;
+  if (reached.ready >= reached_[state]) return;
+  reached_[state] = reached.ready;
   // Keys clipped by the arrival floor are not consistent: a state may be closed before its
   // best `ready` is known. It is then opened again (rare; the result stays exact).
-  s.closed = false;
-  s.entry = entry;
-  s.ready = ready;
-  s.parent = parent;
-  s.arc = arc;
-  s.edge_entry = edge_entry;
-  open_.push(open_entry(ready, estimate, state));
+  states_[state] = reached;
+  open_.push(open_entry(reached.ready, estimate, state));
 }
 
 // Inlined into drive, the search's innermost loop: called there, it cost the planner 2 %
@@ -469,10 +466,12 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
       return false;  // later windows are later still
     }
     if (block == kNone) block = states_of(input, current.layer, move.to);
-    if (arrival >= states_[block + j].ready) return true;
+    if (arrival >= reached_[block + j]) return true;
     if (to_go < 0) to_go = estimate(input, current.layer, move.to);
     if (to_go == kUnreachable) return false;  // nor any other window of move.to
-    improve(block + j, arrival, arrival, from, move.arc, onto_edge, to_go);
+    improve(block + j,
+            State{arrival, arrival, onto_edge, from, move.arc, move.to, j, current.layer, false},
+            to_go);
     // The state may be expanded soon (often next: the search dives), and the moves of its
     // vertex are a cache miss more often than not after a reserve: fetched meanwhile.
     __builtin_prefetch(input.traversal->adjacency(*input.graph).out_of(move.to).data());
@@ -542,8 +541,10 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   if (arrival_floor_ == kForever) return outcome;  // the stop can never be entered and held
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
-  improve(states_of(input, 0, input.start) + start_window_, input.start_time, input.start_time,
-          kNone, kNone, 0, start_estimate);
+  improve(states_of(input, 0, input.start) + start_window_,
+          State{input.start_time, input.start_time, 0, kNone, kNone, input.start, start_window_, 0,
+                false},
+          start_estimate);
 
   while (!open_.empty()) {
     const OpenEntry top = open_.pop();
@@ -614,8 +615,10 @@ void WindowSearch::expand(const SearchInput& input, std::uint32_t index, const S
       outcome.horizon_cut = true;
     } else if (ready < window_end && next_estimate != kUnreachable) {
       const std::uint32_t block = states_of(input, current.layer + 1u, vertex);
-      improve(block + current.window, current.entry, ready, index,
-              kNone, 0, next_estimate);
+      improve(block + current.window,
+              State{current.entry, ready, 0, index, kNone, vertex, current.window,
+                    static_cast<std::uint16_t>(current.layer + 1u), false},
+              next_estimate);
     }
   }
   const auto moves = input.traversal->adjacency(*input.graph).out_of(vertex);
