@@ -191,13 +191,15 @@ struct Planner::Impl {
     }
     if (request.stops.empty()) return invalid("the request has no stops");
     for (std::size_t k = 0; k < request.stops.size(); ++k) {
+      // The stop's name is formatted only for an error: every plan passes here.
       const Stop& stop = request.stops[k];
-      const std::string what = fmt::format("stop {}", k);
-      if (stop.vertex >= topology().vertex_count()) return not_vertex(stop.vertex, what);
+      if (stop.vertex >= topology().vertex_count()) {
+        return not_vertex(stop.vertex, fmt::format("stop {}", k));
+      }
       if (!stop.dwell) continue;
       const bool last = k + 1 == request.stops.size();
       if (*stop.dwell < 0 || (last && *stop.dwell == 0) || *stop.dwell > kLatestTime) {
-        return invalid(fmt::format("{} ({}): dwell {} ns must be {} (and not huge)", what,
+        return invalid(fmt::format("stop {} ({}): dwell {} ns must be {} (and not huge)", k,
                                    vertex_name(stop.vertex), *stop.dwell,
                                    last ? "> 0 for the last stop, or absent for an open-ended hold"
                                         : ">= 0"));
@@ -208,17 +210,19 @@ struct Planner::Impl {
 
   std::optional<PlanError> check_usable(const Traversal& traversal,
                                         const PlanRequest& request) const {
-    const auto check = [&](EntityIndex v, const std::string& what) -> std::optional<PlanError> {
-      if (traversal.usable_vertex(v)) return std::nullopt;
+    // The vertex's name is formatted only for an error: every plan passes here.
+    const auto restricted = [&](EntityIndex v, const std::string& what) {
       return error(PlanFailure::restricted,
                    fmt::format("vehicle '{}' may not use {} {}: {}", request.vehicle.id, what,
                                vertex_name(v),
                                *restriction_violation(topology().vertex(v).restrictions,
                                                       request.vehicle)));
     };
-    if (auto bad = check(request.start, "start vertex")) return bad;
+    if (!traversal.usable_vertex(request.start)) return restricted(request.start, "start vertex");
     for (std::size_t k = 0; k < request.stops.size(); ++k) {
-      if (auto bad = check(request.stops[k].vertex, fmt::format("stop {}", k))) return bad;
+      if (!traversal.usable_vertex(request.stops[k].vertex)) {
+        return restricted(request.stops[k].vertex, fmt::format("stop {}", k));
+      }
     }
     return std::nullopt;
   }
