@@ -246,7 +246,7 @@ TEST(JsonFormat, TopLevelAndOptionProblemsAreReported) {
       "edges": [], "footprint_options": {"disc_points": 100000000000, "vertex_radius": -1}})"));
   EXPECT_TRUE(has_diagnostic(range, "footprint_options.disc_points", "between 3 and"))
       << dump(range);
-  EXPECT_TRUE(has_diagnostic(range, "footprint_options.vertex_radius", "positive"))
+  EXPECT_TRUE(has_diagnostic(range, "footprint_options.vertex_radius", "from 0.01 to 10000"))
       << dump(range);
 
   const auto huge = errors_of(parse_topology_json(R"({"name": "o", "vertices": [

@@ -158,6 +158,15 @@ TEST(MovingAi, ShortFilesAndBadOptionsAreReported) {
   ASSERT_FALSE(bad_options.has_value());
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.cell_size", "at least 0.01"));
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.max_speed", "positive"));
+
+  // 1 001 cells of 1 km reach past the coordinates a topology allows.
+  MovingAiOptions wide;
+  wide.cell_size = 1000;
+  const auto too_wide = parse_movingai_map(
+      "type octile\nheight 1\nwidth 1001\nmap\n" + std::string(1001, '.') + "\n", "x", wide);
+  ASSERT_FALSE(too_wide.has_value());
+  EXPECT_TRUE(has_diagnostic(too_wide.error(), "options.cell_size", "at most 999.001"))
+      << dump(too_wide.error());
 }
 
 TEST(MovingAi, MutatedInputNeverCrashes) {

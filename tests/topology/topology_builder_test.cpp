@@ -245,13 +245,61 @@ TEST(TopologyBuilder, RejectsNonFiniteNumbersAndBadOptions) {
 
   const Diagnostics diagnostics = build_errors(std::move(builder));
   const std::string all = dump(diagnostics);
-  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.vertex_radius", "positive")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.vertex_radius", "from 0.01 to 10000"))
+      << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.disc_points", "between 3 and 256")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[0].x", "finite")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].y", "finite")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].restrictions.max_speed", "positive"))
       << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "edges[0].length", "finite")) << all;
+}
+
+// Far out, or with tiny generated footprints, doubles would round two vertices on one spot
+// (or a few metres apart) to footprints that no longer overlap: they would silently stop
+// conflicting. Such files are refused, naming the field.
+TEST(TopologyBuilder, RefusesCoordinatesAndSizesWhereFootprintsLoseTheirArea) {
+  FootprintOptions tiny;
+  tiny.vertex_radius = 1e-9;
+  tiny.edge_half_width = 1e19;
+  TopologyBuilder builder("far", tiny);
+  builder.add_vertex(vertex("a", 1e16, 0));
+  builder.add_vertex(vertex("b", 0, -2e6));
+  builder.add_vertex(vertex("c", 1e6, -1e6));  // on the limit: allowed
+  auto ab = edge("ab", "a", "b");
+  ab.length = 1e300;
+  builder.add_edge(ab);
+  auto bc = edge("bc", "b", "c");
+  bc.footprint = axis_aligned_rectangle(0, -1e6, 1e6 + 1, -1e6 + 1);
+  builder.add_edge(bc);
+
+  const Diagnostics diagnostics = build_errors(std::move(builder));
+  const std::string all = dump(diagnostics);
+  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.vertex_radius", "from 0.01 to 10000"))
+      << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "footprint_options.edge_half_width", "from 0.01 to 10000"))
+      << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[0].x", "within 1000000 m")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].y", "within 1000000 m")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "edges[0].length", "at most 10000000")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "edges[1].footprint", "more than 1000000 m")) << all;
+  EXPECT_EQ(diagnostics.size(), 6u) << all;
+}
+
+TEST(TopologyBuilder, TheSmallestGeneratedFootprintsStillConflictOnOneSpot) {
+  for (const bool disc : {false, true}) {
+    FootprintOptions options;
+    options.vertex_radius = kMinFootprintOption;
+    options.edge_half_width = kMinFootprintOption;
+    options.vertex_disc = disc;
+    options.disc_points = 3;
+    TopologyBuilder builder("spot", options);
+    builder.add_vertex(vertex("a", kMaxCoordinate, -kMaxCoordinate));
+    builder.add_vertex(vertex("b", kMaxCoordinate, -kMaxCoordinate));
+    auto built = std::move(builder).build();
+    ASSERT_TRUE(built.has_value()) << dump(built.error());
+    EXPECT_EQ(built->conflict_pair_count(), 1u) << "disc " << disc;
+  }
 }
 
 TEST(TopologyBuilder, EdgeBetweenVerticesTooCloseForAFootprintIsReported) {

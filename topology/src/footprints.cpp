@@ -85,6 +85,9 @@ std::optional<std::string> normalize_footprint(Polygon& polygon) {
     if (!std::isfinite(corner.x()) || !std::isfinite(corner.y())) {
       return "a corner has a non-finite coordinate";
     }
+    if (std::abs(corner.x()) > kMaxCoordinate || std::abs(corner.y()) > kMaxCoordinate) {
+      return "a corner lies more than 1000000 m (kMaxCoordinate) from the origin";
+    }
   }
   if (!polygon.inners().empty()) return "holes are not supported";
   bg::correct(polygon);

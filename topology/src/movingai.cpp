@@ -1,10 +1,12 @@
 #include "drover/topology/movingai.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -208,6 +210,14 @@ Result<Topology, Diagnostics> build_grid(const Grid& grid, std::string name,
                                          const MovingAiOptions& options) {
   const double cell = options.cell_size;
   const double half = cell / 2;
+  // The far corner of the last cell must stay within the coordinates a topology allows.
+  const int side = std::max(grid.width, grid.height);
+  if (side * cell > kMaxCoordinate) {
+    std::ostringstream what;
+    what << "must be at most " << kMaxCoordinate / side << " (metres) for a map " << side
+         << " cells wide: its cells must lie within 1000000 m (kMaxCoordinate) of the origin";
+    return unexpected(Diagnostics{{"options.cell_size", what.str()}});
+  }
   const auto open = [&grid](int x, int y) {
     return x < grid.width && y < grid.height && passable(grid.rows[y][x]);
   };

@@ -40,15 +40,25 @@ class Validator {
   Diagnostics& diagnostics() { return diagnostics_; }
 
   void check_options(const FootprintOptions& options) {
-    if (!positive_finite(options.vertex_radius)) {
-      report("footprint_options.vertex_radius", "must be a positive finite number");
-    }
-    if (!positive_finite(options.edge_half_width)) {
-      report("footprint_options.edge_half_width", "must be a positive finite number");
-    }
+    const auto size = [&](double value, std::string_view field) {
+      if (!(value >= kMinFootprintOption && value <= kMaxFootprintOption)) {  // NaN too
+        report(field_of("footprint_options", field),
+               "must be a number from 0.01 to 10000 (metres)");
+      }
+    };
+    size(options.vertex_radius, "vertex_radius");
+    size(options.edge_half_width, "edge_half_width");
     if (options.disc_points < 3 || options.disc_points > kMaxDiscPoints) {
       report("footprint_options.disc_points",
              "must be between 3 and " + std::to_string(kMaxDiscPoints));
+    }
+  }
+
+  void check_coordinate(double value, const std::string& where) {
+    if (!std::isfinite(value)) {
+      report(where, "must be finite");
+    } else if (std::abs(value) > kMaxCoordinate) {
+      report(where, "must lie within 1000000 m (kMaxCoordinate) of the origin");
     }
   }
 
@@ -129,8 +139,8 @@ Result<Topology, Diagnostics> TopologyBuilder::build() && {
     spec.where = where_or(spec.where, "vertices", i);
     check.check_id(spec.id, spec.where);
     vertex_by_id.emplace(spec.id, static_cast<EntityIndex>(i));
-    if (!std::isfinite(spec.x)) check.report(field_of(spec.where, "x"), "must be finite");
-    if (!std::isfinite(spec.y)) check.report(field_of(spec.where, "y"), "must be finite");
+    check.check_coordinate(spec.x, field_of(spec.where, "x"));
+    check.check_coordinate(spec.y, field_of(spec.where, "y"));
     if (spec.orientation && !std::isfinite(*spec.orientation)) {
       check.report(field_of(spec.where, "orientation"), "must be finite");
     }
@@ -156,6 +166,8 @@ Result<Topology, Diagnostics> TopologyBuilder::build() && {
     }
     if (spec.length && !positive_finite(*spec.length)) {
       check.report(field_of(spec.where, "length"), "must be a positive finite number");
+    } else if (spec.length && *spec.length > kMaxEdgeLength) {
+      check.report(field_of(spec.where, "length"), "must be at most 10000000 (metres)");
     }
     if (!positive_finite(spec.max_speed)) {
       check.report(field_of(spec.where, "max_speed"), "must be a positive finite number");
