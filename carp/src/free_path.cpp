@@ -64,6 +64,9 @@ Result<FreePath> FreePathSearch::find(const VehicleProfile& vehicle, EntityIndex
     }
   }
   const Traversal& traversal = *m.traversals.get(graph, vehicle).traversal;
+  if (auto slow = traversal.too_slow(graph)) {
+    return fail(ErrorCode::invalid_argument, std::move(*slow));
+  }
   m.begin();
   if (traversal.usable_vertex(start)) {
     m.touch(start);

@@ -19,8 +19,6 @@ using topology::TimelineSet;
 
 namespace {
 
-/// Times beyond this are refused, so that sums of times never overflow.
-constexpr TimeNs kLatestTime = kForever / 4;
 constexpr std::size_t kVehicleClasses = 8;
 
 std::string time_text(TimeNs t) {
@@ -159,6 +157,9 @@ struct Planner::Impl {
 
   std::string vertex_name(EntityIndex v) const { return "'" + topology().id(v) + "'"; }
 
+  /// How long after its start time a route may take: the option, cut to kLatestTime.
+  DurationNs horizon() const { return std::min(options.horizon, kLatestTime); }
+
   std::optional<PlanError> check_request(const TimelineSet& timelines,
                                          const PlanRequest& request) const {
     const auto invalid = [](std::string message) {
@@ -181,6 +182,12 @@ struct Planner::Impl {
                                  timelines.entity_count(), topology().name(),
                                  topology().entity_count()));
     }
+    // A set owning a part sees the rest as held by others: every failure would blame them.
+    if (!timelines.owns_all()) {
+      return invalid(fmt::format("the timelines own only part of topology '{}'; a planner "
+                                 "needs every entity's timeline (a replica of all of them)",
+                                 topology().name()));
+    }
     const auto not_vertex = [&](EntityIndex v, const std::string& what) {
       return invalid(fmt::format("{}: entity {} is not a vertex of topology '{}' ({} vertices)",
                                  what, v, topology().name(), topology().vertex_count()));
@@ -190,6 +197,11 @@ struct Planner::Impl {
       return invalid(fmt::format("start time {} ns is out of range", request.start_time));
     }
     if (request.stops.empty()) return invalid("the request has no stops");
+    if (request.stops.size() > kMaxStops) {
+      return invalid(fmt::format("the request has {} stops, more than the {} one request may have",
+                                 request.stops.size(), kMaxStops));
+    }
+    DurationNs dwells = 0;  // at most kLatestTime + one dwell: no overflow
     for (std::size_t k = 0; k < request.stops.size(); ++k) {
       // The stop's name is formatted only for an error: every plan passes here.
       const Stop& stop = request.stops[k];
@@ -203,6 +215,12 @@ struct Planner::Impl {
                                    vertex_name(stop.vertex), *stop.dwell,
                                    last ? "> 0 for the last stop, or absent for an open-ended hold"
                                         : ">= 0"));
+      }
+      dwells += *stop.dwell;
+      if (dwells > kLatestTime) {
+        return invalid(fmt::format("the dwells of stops 0 to {} add up to more than {}, the "
+                                   "longest the planner takes",
+                                   k, time_text(kLatestTime)));
       }
     }
     return std::nullopt;
@@ -218,6 +236,9 @@ struct Planner::Impl {
                                *restriction_violation(topology().vertex(v).restrictions,
                                                       request.vehicle)));
     };
+    if (auto slow = traversal.too_slow(*graph)) {
+      return error(PlanFailure::invalid_request, std::move(*slow));
+    }
     if (!traversal.usable_vertex(request.start)) return restricted(request.start, "start vertex");
     for (std::size_t k = 0; k < request.stops.size(); ++k) {
       if (!traversal.usable_vertex(request.stops[k].vertex)) {
@@ -253,6 +274,19 @@ struct Planner::Impl {
                      fmt::format("no path leads from {} to {} (stop {}) in topology '{}'",
                                  vertex_name(from), vertex_name(to), k, topology().name()));
       }
+    }
+    // The least time the stops take, counted up to just past the horizon: beyond it no
+    // route can be found, and below it the tails below cannot overflow.
+    DurationNs least = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      const DurationNs dwell = k + 1 < count ? legs[k].dwell : 0;
+      least = std::min(least + leg_time[k] + dwell, horizon() + 1);
+    }
+    if (least > horizon()) {
+      return error(PlanFailure::no_window,
+                   fmt::format("even on an empty topology the stops take more than the "
+                               "horizon of {}: the fastest drive between them and their dwells",
+                               time_text(horizon())));
     }
     legs[count - 1].tail = 0;
     for (std::size_t k = count - 1; k-- > 0;) {
@@ -369,7 +403,7 @@ struct Planner::Impl {
       return error(PlanFailure::no_window,
                    fmt::format("no sequence of free windows reaches {} within the horizon of "
                                "{} after {}",
-                               vertex_name(goal), time_text(options.horizon),
+                               vertex_name(goal), time_text(horizon()),
                                time_text(request.start_time)));
     }
     PlanError failure = error(PlanFailure::no_window,
@@ -407,7 +441,7 @@ struct Planner::Impl {
     input.start = request.start;
     input.start_time = request.start_time;
     input.legs = legs;
-    input.deadline = request.start_time + std::min(options.horizon, kLatestTime);
+    input.deadline = request.start_time + horizon();
     input.quick_proof_after = options.quick_proof_after;
     input.quick_proof_budget = options.quick_proof_budget;
     input.floor_proof_after = options.floor_proof_after;

@@ -5,6 +5,8 @@
 #include <limits>
 #include <map>
 
+#include <fmt/format.h>
+
 namespace drover::carp {
 
 using topology::EntityIndex;
@@ -23,12 +25,20 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   double ns_per_metre = std::numeric_limits<double>::infinity();
   DurationNs shortest = kForever;
   DurationNs longest = 0;
+  const auto most_ns = static_cast<double>(max_arc_time(graph.vertex_count()));
   for (ArcIndex a = 0; a < arcs; ++a) {
     const Arc& arc = graph.arc(a);
     const double speed = std::min(vehicle.max_speed, arc.speed_limit);
-    travel_[a] = std::max<DurationNs>(1, std::llround(arc.length / speed * 1e9));
-    clearance_[a] = std::max<DurationNs>(1, static_cast<DurationNs>(
-                                                std::ceil(vehicle.length / speed * 1e9)));
+    const double travel_ns = arc.length / speed * 1e9;
+    const double clearance_ns = vehicle.length / speed * 1e9;
+    const double longer_ns = std::max(travel_ns, clearance_ns);
+    if (longer_ns > most_ns && (!too_slow_arc_ || longer_ns > too_slow_arc_->seconds * 1e9)) {
+      too_slow_arc_ = SlowArc{a, longer_ns / 1e9};
+    }
+    // Clipped before the conversion, which is undefined beyond the integer's range.
+    travel_[a] = std::max<DurationNs>(1, std::llround(std::min(travel_ns, most_ns)));
+    clearance_[a] =
+        std::max<DurationNs>(1, static_cast<DurationNs>(std::ceil(std::min(clearance_ns, most_ns))));
     usable_arc_[a] = usable_vertex_[arc.to] &&
                      !restriction_violation(topology.edge(arc.edge).restrictions, vehicle);
     if (usable_arc_[a]) {
@@ -45,6 +55,18 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   ns_per_metre_ = std::isfinite(ns_per_metre) ? ns_per_metre * (1 - 1e-9) : 0;
   min_travel_ = shortest == kForever ? 1 : shortest;
   uniform_ = shortest == kForever || shortest == longest;
+}
+
+std::optional<std::string> Traversal::too_slow(const RoutingGraph& graph) const {
+  if (!too_slow_arc_) return std::nullopt;
+  const topology::Topology& topology = graph.topology();
+  return fmt::format(
+      "vehicle '{}' is too slow (or too long) for topology '{}': it would take {:.6g} s to "
+      "drive or clear edge '{}', more than the {:.6g} s allowed per arc on {} vertices (so "
+      "that no route's times overflow)",
+      vehicle_.id, topology.name(), too_slow_arc_->seconds,
+      topology.id(graph.arc(too_slow_arc_->arc).edge),
+      ns_to_seconds(max_arc_time(graph.vertex_count())), graph.vertex_count());
 }
 
 void Traversal::find_components(const RoutingGraph& graph) const {

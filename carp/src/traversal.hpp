@@ -4,10 +4,14 @@
 
 #include <compare>
 #include <cstdint>
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "drover/carp/route.hpp"
 #include "drover/carp/routing_graph.hpp"
 #include "drover/carp/vehicle.hpp"
 #include "drover/common/clock.hpp"
@@ -32,6 +36,18 @@ class Traversal {
   DurationNs clearance(ArcIndex arc) const { return clearance_[arc]; }
   /// The shortest travel() of a usable arc (1 ns when none is usable).
   DurationNs min_travel() const { return min_travel_; }
+
+  /// The most a travel() or clearance() may take on a graph of `vertex_count` vertices:
+  /// then no path's travel time (at most one arc per vertex) passes kLatestTime, and the
+  /// searches' sums of times and durations stay far from overflowing.
+  static DurationNs max_arc_time(std::size_t vertex_count) {
+    return kLatestTime / static_cast<DurationNs>(std::max<std::size_t>(vertex_count, 1));
+  }
+  /// Why the vehicle cannot be planned for on `graph` (the one it was built for), if so:
+  /// on some arc its travel or clearance would pass max_arc_time (a vehicle far too slow,
+  /// or too long). Such an arc's times are clipped to that bound, so a search must refuse
+  /// the vehicle rather than use them.
+  std::optional<std::string> too_slow(const RoutingGraph& graph) const;
   /// Every usable arc takes the same time (a grid with one speed): shortest paths by time
   /// are shortest by arc count.
   bool uniform() const { return uniform_; }
@@ -152,6 +168,13 @@ class Traversal {
   mutable std::vector<std::uint32_t> component_;
   mutable Adjacency adjacency_;  // empty until adjacency() needs it (a cache, as component_)
   double ns_per_metre_ = 0;
+  // The arc whose travel or clearance passes max_arc_time by the most, if any, and that
+  // time in seconds.
+  struct SlowArc {
+    ArcIndex arc;
+    double seconds;
+  };
+  std::optional<SlowArc> too_slow_arc_;
   DurationNs min_travel_ = 1;
   bool uniform_ = true;
 };

@@ -129,7 +129,9 @@ void WindowSearch::add_states(const SearchInput& input, std::size_t key, EntityI
 TimeNs WindowSearch::held_from(const SearchInput& input, Interval window, TimeNs at) {
   const DurationNs hold = input.legs.back().dwell;
   at = std::max(at, window.start);
-  const bool holds = hold == kForever ? window.end == kForever : at + hold <= window.end;
+  // at + hold <= window.end, without the sum: `at` may be a window start near kForever.
+  const bool holds = hold == kForever ? window.end == kForever
+                                      : at <= window.end && hold <= window.end - at;
   return holds ? at : kForever;
 }
 
@@ -167,9 +169,11 @@ TimeNs WindowSearch::arrival_over(const SearchInput& input, ArcIndex arc, TimeNs
   for (std::uint32_t e = ending_after(first, count, input.start_time); e < count; ++e) {
     const Interval edge = first[e];
     const TimeNs onto_edge = std::max(edge.start, input.start_time);
-    if (onto_edge + travel >= bound) break;
+    // Compared without sums: a window may start near kForever (bound - travel and
+    // edge.end - clearance cannot overflow: both times are >= 0, the durations bounded).
+    if (onto_edge >= bound - travel) break;
     const TimeNs z = held_after(input, onto_edge + travel);
-    if (z != kForever && z + clearance <= edge.end) return z;
+    if (z != kForever && z <= edge.end - clearance) return z;
   }
   return kForever;
 }
@@ -417,12 +421,13 @@ WindowSearch::OpenEntry WindowSearch::open_entry(TimeNs ready, DurationNs estima
 
 // Inlined into drive, the search's innermost loop: called there, it cost the planner 2 %
 // more instructions (bench plan, random N = 200).
-template <class Arrive>
+template <class Arrive, class PastDeadline>
 [[gnu::always_inline]] inline void WindowSearch::arrivals(const SearchInput& input,
                                                           const State& current,
                                                           TimeNs window_end,
                                                           const Traversal::Move& move,
-                                                          Arrive&& arrive) {
+                                                          Arrive&& arrive,
+                                                          PastDeadline&& past_deadline) {
   const Traversal::Timing& timing = input.traversal->adjacency(*input.graph).timing(move);
   const DurationNs travel = timing.travel;
   const DurationNs clearance = timing.clearance;
@@ -439,7 +444,14 @@ template <class Arrive>
     const Interval edge = edge_first[i];
     if (edge.start > latest_onto_edge) break;
     const TimeNs onto_edge = std::max(current.ready, edge.start);
-    const TimeNs earliest_arrival = onto_edge + travel;
+    // A window may start so near kForever that the arrival is past every time: it and the
+    // later ones only lead past the deadline. (A test of the overflow flag: the cheapest
+    // guard in this loop, one instruction.)
+    TimeNs earliest_arrival = 0;
+    if (__builtin_add_overflow(onto_edge, travel, &earliest_arrival)) [[unlikely]] {
+      past_deadline();
+      break;
+    }
     const TimeNs latest_arrival = edge.end - clearance;  // the tail must leave the edge too
     if (earliest_arrival > latest_arrival) continue;
     if (vertex_first == nullptr) vertex_first = windows_of(input, move.to, vertex_count);
@@ -477,7 +489,7 @@ void WindowSearch::drive(const SearchInput& input, std::uint32_t from, const Sta
     __builtin_prefetch(input.traversal->adjacency(*input.graph).out_of(move.to).data());
     return true;
   };
-  arrivals(input, current, window_end, move, arrive);
+  arrivals(input, current, window_end, move, arrive, [&] { outcome.horizon_cut = true; });
 }
 
 // Why a successor always exists (the converse of prove_late's soundness): a state's label
@@ -513,7 +525,7 @@ void WindowSearch::follow_labels(const SearchInput& input) {
           next_h = h;
         }
         return false;  // later windows of this edge window are reached later
-      });
+      }, [] {});
     }
     // Never without a successor: the label of `at` came from one (see above).
     at = next;

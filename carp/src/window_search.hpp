@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -83,9 +84,10 @@ class WindowSearch {
     std::uint32_t arc;       // the arc it came by; kNone at the start or after a stop
     std::uint32_t vertex;
     std::uint32_t window;    // which window of its vertex (see windows_of)
-    std::uint16_t layer;
+    std::uint16_t layer;     // which leg (stop) it heads for: kMaxStops fit
     bool closed;
   };
+  static_assert(kMaxStops - 1 <= std::numeric_limits<decltype(State::layer)>::max());
   /// An open state, keyed by a lower bound of the arrival through it.
   struct OpenEntry {
     TimeNs f;                // max(ready + h, arrival_floor_)
@@ -313,10 +315,11 @@ class WindowSearch {
   /// at `onto_edge`, arriving at `arrival`, both the earliest possible; in order of the
   /// edge's windows, and for each of the destination's windows in order. When arrive returns
   /// false, the destination's later windows are skipped for that edge window (they are
-  /// reached later still).
-  template <class Arrive>
+  /// reached later still). Edge windows where the arrival would pass kForever (they open
+  /// that late) are not driven: past_deadline() is called instead, once.
+  template <class Arrive, class PastDeadline>
   void arrivals(const SearchInput& input, const State& current, TimeNs window_end,
-                const Traversal::Move& move, Arrive&& arrive);
+                const Traversal::Move& move, Arrive&& arrive, PastDeadline&& past_deadline);
   /// Drives `move` from state `from` (`current`, a copy: states_ may grow; its window ends
   /// at `window_end`) into every window of its destination it can reach.
   void drive(const SearchInput& input, std::uint32_t from, const State& current,

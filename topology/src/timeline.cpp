@@ -110,6 +110,7 @@ TimelineSet::TimelineSet(std::vector<std::vector<EntityIndex>> conflict_sets,
                          std::vector<bool> owned)
     : conflict_sets_(clean_conflict_sets(std::move(conflict_sets))),
       owned_(owned_flags(std::move(owned), conflict_sets_.size())),
+      owns_all_(std::find(owned_.begin(), owned_.end(), false) == owned_.end()),
       timelines_(conflict_sets_.size()),
       held_(conflict_sets_.size()),
       revisions_{std::vector<std::uint64_t>(conflict_sets_.size())},

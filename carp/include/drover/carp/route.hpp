@@ -13,6 +13,13 @@
 
 namespace drover::carp {
 
+/// The latest start time, the longest dwell, the longest sum of a request's dwells and the
+/// longest horizon the planner takes (about 73 years; a longer horizon is cut to it), so
+/// that its sums of times never overflow.
+inline constexpr TimeNs kLatestTime = kForever / 4;
+/// The most stops one request may have.
+inline constexpr std::size_t kMaxStops = 65536;
+
 /// A vertex the route must reach, in request order.
 struct Stop {
   topology::EntityIndex vertex = topology::kNoEntity;
@@ -29,7 +36,7 @@ struct PlanRequest {
   VehicleProfile vehicle;
   topology::EntityIndex start = topology::kNoEntity;  ///< a vertex; held from start_time
   TimeNs start_time = 0;
-  std::vector<Stop> stops;   ///< at least one
+  std::vector<Stop> stops;   ///< at least one, at most kMaxStops
 };
 
 /// A planned route.

@@ -209,6 +209,9 @@ class TimelineSet {
 
   std::size_t entity_count() const noexcept;
   bool owns(EntityIndex entity) const noexcept;
+  /// Whether the set owns every entity (a replica of the whole topology, as a planner
+  /// needs). Constant time.
+  bool owns_all() const noexcept { return owns_all_; }
   /// How many locks the set holds, over all its timelines (all owned: lock, restore and
   /// replace_timeline take locks on owned entities only). Constant time.
   std::size_t lock_count() const noexcept;
@@ -462,6 +465,7 @@ class TimelineSet {
   };
   std::vector<std::vector<EntityIndex>> conflict_sets_;
   std::vector<bool> owned_;                       // one flag per entity
+  bool owns_all_ = true;                          // every flag of owned_ is set
   std::vector<Timeline> timelines_;
   std::vector<std::optional<AllocatedStep>> held_;  // per entity; set iff its holder is
   std::map<PrepareId, PreparedSet> prepared_;
