@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/output_file.hpp"
 #include "bench/scenario.hpp"
 #include "drover/carp/free_path.hpp"
 #include "drover/carp/planner.hpp"
@@ -203,13 +204,14 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
 
   // Opened once the input is checked, before any work: a paths file that cannot be
   // written is bad input, refused before the run rather than after minutes of it.
-  std::ofstream paths_out;
+  std::optional<OutputFile> paths_out;
   if (!arguments.paths.empty()) {
-    paths_out.open(arguments.paths);
-    if (!paths_out) {
-      std::cerr << "error: " << arguments.paths << ": cannot open the paths file for writing\n";
+    auto opened = OutputFile::open(arguments.paths, {arguments.map, arguments.scenario});
+    if (!opened) {
+      std::cerr << "error: " << opened.error().message << "\n";
       return cli::kExitBadInput;
     }
+    paths_out.emplace(std::move(opened).value());
   }
 
   const auto graph = std::make_shared<const carp::RoutingGraph>(map);
@@ -279,8 +281,8 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
        planned_astar_seconds > 0 ? planned_plan_seconds / planned_astar_seconds : 0.0},
   };
   // The paths first: the result line is printed only for a run whose output is complete.
-  if (paths_out.is_open()) {
-    for (std::size_t i = 0; i < agents.size() && paths_out; ++i) {
+  if (paths_out) {
+    for (std::size_t i = 0; i < agents.size() && paths_out->stream(); ++i) {
       nlohmann::json path = {{"agent", i}};
       const Outcome& outcome = run.outcomes[i];
       if (outcome.route) {
@@ -290,11 +292,10 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
         path["error"] = fmt::format("{}: {}", carp::to_string(outcome.error->reason),
                                     outcome.error->message);
       }
-      paths_out << path.dump() << "\n";
+      paths_out->stream() << path.dump() << "\n";
     }
-    paths_out.flush();
-    if (!paths_out) {
-      std::cerr << "error: " << arguments.paths << ": cannot write the paths file\n";
+    if (auto written = paths_out->commit(); !written) {
+      std::cerr << "error: " << written.error().message << "\n";
       return cli::kExitFailure;
     }
   }
@@ -317,7 +318,11 @@ void add_bench_plan_command(CLI::App& bench, cli::CommandContext& context) {
       ->required()
       ->check(cli::positive());
   plan->add_option("--paths", arguments->paths,
-                   "Also write one JSON line per agent with its steps to this file");
+                   "Also write one JSON line per agent with its steps to this file (written "
+                   "as FILE.partial, renamed when complete)")
+      ->check(CLI::Validator(
+          [](std::string& path) { return path.empty() ? std::string("must not be empty") : ""; },
+          "FILE"));
   plan->add_option("--repeat", arguments->repeat,
                    "Run the whole measurement this many times and report median times")
       ->check(CLI::Range(1, 100));

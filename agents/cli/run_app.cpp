@@ -25,6 +25,12 @@ int run_app(CLI::App& app, const CommandContext& context, int argc, char** argv)
     std::cerr << "error: internal: " << e.what() << "\n";
     return kExitFailure;
   }
+  // A tool's answer is what it printed: lost (a full disk, a closed pipe), the run failed.
+  std::cout.flush();
+  if (!std::cout) {
+    std::cerr << "error: cannot write to standard output\n";
+    return context.exit_code == kExitOk ? kExitFailure : context.exit_code;
+  }
   return context.exit_code;
 }
 

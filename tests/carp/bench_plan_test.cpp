@@ -67,16 +67,20 @@ class BenchPlan : public ::testing::Test {
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
-  CommandRun bench_plan(const std::vector<std::string>& arguments) {
+  /// Runs `drover bench plan` with standard output to `out` (a file of the test's own by
+  /// default, read back into the result).
+  CommandRun bench_plan(const std::vector<std::string>& arguments,
+                        const std::string& out_file = "") {
     const char* binary_dir = std::getenv("DROVER_BINARY_DIR");
     const fs::path binary = fs::path(binary_dir ? binary_dir : "build") / "bin" / "drover";
     std::string command = quoted(binary.string()) + " bench plan";
     for (const auto& argument : arguments) command += " " + quoted(argument);
-    command += " >" + quoted(path("stdout")) + " 2>" + quoted(path("stderr"));
+    const std::string out = out_file.empty() ? path("stdout") : out_file;
+    command += " >" + quoted(out) + " 2>" + quoted(path("stderr"));
     const int status = std::system(command.c_str());
     CommandRun run;
     if (status != -1 && WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
-    run.out = read_all(path("stdout"));
+    if (out == path("stdout")) run.out = read_all(out);
     run.err = read_all(path("stderr"));
     return run;
   }
@@ -174,7 +178,14 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
       // Refused before the run: no result line for output that could not be written.
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1", "--paths",
         path("no-such-dir/paths.jsonl")},
-       path("no-such-dir/paths.jsonl") + ": cannot open the paths file for writing"},
+       path("no-such-dir/paths.jsonl") + ": cannot open " + path("no-such-dir/paths.jsonl") +
+           ".partial for writing"},
+      // Never over an input.
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1", "--paths",
+        path("ring.scen")},
+       path("ring.scen") + ": is an input of this run"},
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1", "--paths", ""},
+       "--paths: must not be empty"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.message);
@@ -183,6 +194,36 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
     EXPECT_EQ(run.out, "");
     EXPECT_NE(run.err.find(c.message), std::string::npos) << run.err;
   }
+  EXPECT_EQ(read_all(path("ring.scen")).rfind("version 1", 0), 0u) << "the input is intact";
+}
+
+// The paths file appears whole or not at all: a run that refuses its input leaves an
+// earlier run's file as it was, and a complete run replaces it, leaving no partial file.
+TEST_F(BenchPlan, ThePathsFileIsReplacedOnlyWhenComplete) {
+  write("paths.jsonl", "an earlier run's paths\n");
+  const CommandRun refused = bench_plan({"--map", path("ring.map"), "--scen", path("ring.scen"),
+                                         "--agents", "4", "--paths", path("paths.jsonl")});
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_EQ(read_all(path("paths.jsonl")), "an earlier run's paths\n");
+
+  const CommandRun run = bench_plan({"--map", path("ring.map"), "--scen", path("ring.scen"),
+                                     "--agents", "3", "--paths", path("paths.jsonl")});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::istringstream lines(read_all(path("paths.jsonl")));
+  std::string text;
+  int count = 0;
+  while (std::getline(lines, text)) ++count;
+  EXPECT_EQ(count, 3);
+  EXPECT_FALSE(std::filesystem::exists(path("paths.jsonl.partial")));
+}
+
+// A result that cannot be printed is a failed run (exit 1), not a silent success.
+TEST_F(BenchPlan, AnUnwritableStandardOutputFailsTheRun) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  const CommandRun run = bench_plan(
+      {"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1"}, "/dev/full");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("cannot write to standard output"), std::string::npos) << run.err;
 }
 
 }  // namespace

@@ -1,0 +1,72 @@
+#include "bench/output_file.hpp"
+
+#include <system_error>
+#include <utility>
+
+#include <fmt/format.h>
+
+namespace drover::bench {
+
+namespace {
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code error;
+  return std::filesystem::equivalent(a, b, error) && !error;
+}
+
+}  // namespace
+
+OutputFile::OutputFile(std::filesystem::path path, std::filesystem::path partial)
+    : path_(std::move(path)), partial_(std::move(partial)), out_(partial_) {}
+
+OutputFile::OutputFile(OutputFile&& other) noexcept
+    : path_(std::move(other.path_)),
+      partial_(std::move(other.partial_)),
+      out_(std::move(other.out_)),
+      done_(std::exchange(other.done_, true)) {}
+
+Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
+                                    const std::vector<std::filesystem::path>& inputs) {
+  for (const auto& input : inputs) {
+    if (same_file(path, input)) {
+      return fail(ErrorCode::invalid_argument,
+                  fmt::format("{}: is an input of this run; writing to it would overwrite it",
+                              path.string()));
+    }
+  }
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    return fail(ErrorCode::invalid_argument, fmt::format("{}: is a directory", path.string()));
+  }
+  std::filesystem::path partial = path;
+  partial += ".partial";
+  OutputFile file(path, partial);
+  if (!file.out_) {
+    return fail(ErrorCode::io,
+                fmt::format("{}: cannot open {} for writing", path.string(), partial.string()));
+  }
+  return file;
+}
+
+OutputFile::~OutputFile() {
+  if (done_) return;
+  out_.close();
+  std::error_code ignored;
+  std::filesystem::remove(partial_, ignored);
+}
+
+Status OutputFile::commit() {
+  out_.flush();
+  const bool written = static_cast<bool>(out_);
+  out_.close();
+  std::error_code error;
+  if (written && !out_.fail()) std::filesystem::rename(partial_, path_, error);
+  if (!written || out_.fail() || error) {
+    std::filesystem::remove(partial_, error);
+    return fail(ErrorCode::io, fmt::format("{}: cannot write the file", path_.string()));
+  }
+  done_ = true;
+  return {};
+}
+
+}  // namespace drover::bench

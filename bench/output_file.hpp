@@ -1,0 +1,39 @@
+#pragma once
+// An output file that appears only when complete: written under a temporary name beside it
+// and renamed over it at the end, so that a failed or interrupted run never leaves a cut-off
+// file, nor wipes the one an earlier run wrote.
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "drover/common/result.hpp"
+
+namespace drover::bench {
+
+class OutputFile {
+ public:
+  /// Opens `path`'s temporary file (`path` + ".partial"). Fails, naming the file, when it
+  /// cannot be created, or when `path` is one of `inputs` (it would overwrite them).
+  static Result<OutputFile> open(const std::filesystem::path& path,
+                                 const std::vector<std::filesystem::path>& inputs);
+  OutputFile(OutputFile&& other) noexcept;
+  OutputFile& operator=(OutputFile&&) = delete;
+  /// Removes the temporary file unless commit() succeeded.
+  ~OutputFile();
+
+  std::ofstream& stream() { return out_; }
+  /// Flushes and renames the temporary file to the path. Fails, naming the file, when
+  /// writing or renaming failed (the temporary file is removed then).
+  Status commit();
+
+ private:
+  OutputFile(std::filesystem::path path, std::filesystem::path partial);
+  std::filesystem::path path_;
+  std::filesystem::path partial_;
+  std::ofstream out_;
+  bool done_ = false;  // committed, or moved from: nothing to remove
+};
+
+}  // namespace drover::bench
