@@ -18,6 +18,7 @@
 #include "drover/carp/free_path.hpp"
 #include "drover/carp/planner.hpp"
 #include "drover/common/logging.hpp"
+#include "drover/common/text_file.hpp"
 #include "drover/topology/movingai.hpp"
 
 namespace drover::bench {
@@ -189,7 +190,7 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
     const ScenarioTask& task = (*tasks)[i];
     if (task.map != map_name) {
       logger->warn("{}:{}: the task is for map {}, running it on {}", arguments.scenario,
-                   task.line, task.map, map_name);
+                   task.line, printable_excerpt(task.map), map_name);
     }
     const auto start = map.find(fmt::format("{},{}", task.start_x, task.start_y));
     const auto goal = map.find(fmt::format("{},{}", task.goal_x, task.goal_y));

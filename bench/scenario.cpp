@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <charconv>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
+
+#include "drover/common/text_file.hpp"
 
 namespace drover::bench {
 
@@ -60,7 +60,7 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
       const auto fields = split_fields(line);
       double version = 0;
       if (fields.size() != 2 || fields[0] != "version" || !parse_number(fields[1], version)) {
-        return bad(line_number, fmt::format("expected \"version 1\", got \"{}\"", line));
+        return bad(line_number, fmt::format("expected \"version 1\", got {}", printable_excerpt(line)));
       }
       if (version != 1) return bad(line_number, fmt::format("unsupported version {}", fields[1]));
       header_seen = true;
@@ -85,13 +85,13 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
                     {"goal y", fields[7], &task.goal_y}};
     for (const auto& field : integers) {
       if (!parse_number(field.text, *field.value) || *field.value < 0) {
-        return bad(line_number, fmt::format("{} \"{}\" is not a non-negative integer", field.what,
-                                            field.text));
+        return bad(line_number, fmt::format("{} {} is not a non-negative integer", field.what,
+                                            printable_excerpt(field.text)));
       }
     }
     if (!parse_number(fields[8], task.optimal_length) || !(task.optimal_length >= 0)) {
-      return bad(line_number, fmt::format("optimal length \"{}\" is not a non-negative number",
-                                          fields[8]));
+      return bad(line_number, fmt::format("optimal length {} is not a non-negative number",
+                                          printable_excerpt(fields[8])));
     }
     if (task.start_x >= task.map_width || task.goal_x >= task.map_width ||
         task.start_y >= task.map_height || task.goal_y >= task.map_height) {
@@ -106,12 +106,9 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
 }
 
 Result<std::vector<ScenarioTask>> load_scenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::io, fmt::format("{}: cannot open the scenario file", path.string()));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return fail(ErrorCode::io, fmt::format("{}: cannot read the scenario file", path.string()));
-  return parse_scenario(text.str(), path.string());
+  auto text = read_text_file(path);
+  if (!text) return fail(ErrorCode::io, fmt::format("{}: {}", path.string(), text.error().message));
+  return parse_scenario(*text, path.string());
 }
 
 }  // namespace drover::bench

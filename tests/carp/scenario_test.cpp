@@ -1,5 +1,8 @@
 // MovingAI scenario parsing for `drover bench plan`: good files and the errors of bad ones.
 
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "bench/scenario.hpp"
@@ -38,10 +41,12 @@ TEST(Scenario, ReportsTheLineAndWhatIsWrong) {
       {"version 2\n", "s.scen:1: unsupported version 2"},
       {"3\tm.map\t8\t8\t0\t0\t1\t1\t2\n", "s.scen:1: expected \"version 1\""},
       {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\n", "s.scen:2: expected 9 fields"},
-      {"version 1\n0\tm.map\t8\t8\tx\t0\t1\t1\t2\n", "s.scen:2: start x \"x\" is not"},
-      {"version 1\n0\tm.map\t8\t8\t-1\t0\t1\t1\t2\n", "s.scen:2: start x \"-1\" is not"},
+      {"version 1\n0\tm.map\t8\t8\tx\t0\t1\t1\t2\n", "s.scen:2: start x 'x' is not"},
+      {"version 1\n0\tm.map\t8\t8\t-1\t0\t1\t1\t2\n", "s.scen:2: start x '-1' is not"},
       {"version 1\n0\tm.map\t8\t8\t0\t0\t8\t1\t2\n", "s.scen:2: start (0,0) or goal (8,1) lies"},
-      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\tfar\n", "s.scen:2: optimal length \"far\""},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\tfar\n", "s.scen:2: optimal length 'far'"},
+      // The file's bytes are quoted safely: escapes shown, not sent to the terminal.
+      {"version 1\x1b[31mRED\n", "s.scen:1: expected \"version 1\", got 'version 1\\x1B[31mRED'"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.text);
@@ -50,6 +55,21 @@ TEST(Scenario, ReportsTheLineAndWhatIsWrong) {
     EXPECT_EQ(tasks.error().code, ErrorCode::parse);
     EXPECT_EQ(tasks.error().message.rfind(c.message, 0), 0u) << tasks.error().message;
   }
+}
+
+TEST(Scenario, ALongLineIsQuotedInPart) {
+  const auto tasks = parse_scenario("version " + std::string(1000, '9') + "x\n", "s.scen");
+  ASSERT_FALSE(tasks.has_value());
+  EXPECT_LT(tasks.error().message.size(), 120u) << tasks.error().message;
+  EXPECT_NE(tasks.error().message.find("...'"), std::string::npos) << tasks.error().message;
+}
+
+TEST(Scenario, ADirectoryIsNotAScenario) {
+  const auto tasks = load_scenario(std::filesystem::temp_directory_path());
+  ASSERT_FALSE(tasks.has_value());
+  EXPECT_EQ(tasks.error().code, ErrorCode::io);
+  EXPECT_NE(tasks.error().message.find("is a directory"), std::string::npos)
+      << tasks.error().message;
 }
 
 TEST(Scenario, AMissingFileIsAnIoError) {

@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drover/common/text_file.hpp"
 #include "drover/topology/footprints.hpp"
-#include "text_file.hpp"
 
 namespace drover::topology {
 
@@ -488,8 +488,8 @@ Result<Topology, Diagnostics> parse_topology_json(std::string_view text) {
 }
 
 Result<Topology, Diagnostics> load_topology_json(const std::filesystem::path& path) {
-  auto text = detail::read_text_file(path);
-  if (!text) return unexpected(std::move(text).error());
+  auto text = read_text_file(path);
+  if (!text) return unexpected(Diagnostics{{"", std::move(text).error().message}});
   return parse_topology_json(*text);
 }
 

@@ -4,14 +4,13 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
 
+#include "drover/common/text_file.hpp"
 #include "drover/topology/footprints.hpp"
-#include "text_file.hpp"
 
 namespace drover::topology {
 
@@ -51,24 +50,6 @@ std::vector<std::string_view> words(std::string_view line) {
   return found;
 }
 
-/// A quoted excerpt that is safe to print whatever bytes the file holds.
-std::string printable(std::string_view text) {
-  constexpr std::size_t kMaxShown = 40;
-  std::string shown = "'";
-  for (std::size_t i = 0; i < text.size() && i < kMaxShown; ++i) {
-    const auto byte = static_cast<unsigned char>(text[i]);
-    if (std::isprint(byte)) {
-      shown += text[i];
-    } else {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
-      shown += escaped;
-    }
-  }
-  shown += text.size() > kMaxShown ? "...'" : "'";
-  return shown;
-}
-
 bool passable(char cell) { return cell == '.' || cell == 'G' || cell == 'S'; }
 bool impassable(char cell) { return cell == '@' || cell == 'O' || cell == 'T' || cell == 'W'; }
 
@@ -89,7 +70,7 @@ class MapReader {
     Grid grid;
     if (const auto type = header_line(0, "type octile")) {
       if (type->size() != 2 || (*type)[0] != "type" || (*type)[1] != "octile") {
-        report(0, "expected 'type octile', got " + printable(lines_[0]));
+        report(0, "expected 'type octile', got " + printable_excerpt(lines_[0]));
       }
     }
     // Height and width, in this order by convention; either order is accepted.
@@ -103,7 +84,7 @@ class MapReader {
       const bool is_height = line->size() == 2 && (*line)[0] == "height";
       const bool is_width = line->size() == 2 && (*line)[0] == "width";
       if (!is_height && !is_width) {
-        report(index, "expected 'height H' or 'width W', got " + printable(lines_[index]));
+        report(index, "expected 'height H' or 'width W', got " + printable_excerpt(lines_[index]));
         continue;
       }
       bool& seen = is_height ? height_seen : width_seen;
@@ -116,7 +97,7 @@ class MapReader {
     }
     if (const auto map = header_line(3, "map")) {
       if (map->size() != 1 || (*map)[0] != "map") {
-        report(3, "expected 'map', got " + printable(lines_[3]));
+        report(3, "expected 'map', got " + printable_excerpt(lines_[3]));
       }
     }
     if (lines_.size() >= kHeaderLines) {
@@ -156,7 +137,7 @@ class MapReader {
     if (error != std::errc{} || end != text.data() + text.size() || value <= 0 ||
         value > kMaxSide) {
       report(index, "expected a whole number from 1 to " + std::to_string(kMaxSide) +
-                        ", got " + printable(text));
+                        ", got " + printable_excerpt(text));
       return std::nullopt;
     }
     return value;
@@ -173,7 +154,7 @@ class MapReader {
       }
       for (std::size_t column = 0; column < cells.size(); ++column) {
         if (passable(cells[column]) || impassable(cells[column])) continue;
-        report(index, "unexpected character " + printable(cells.substr(column, 1)) +
+        report(index, "unexpected character " + printable_excerpt(cells.substr(column, 1)) +
                           " at column " + std::to_string(column + 1) +
                           " (expected . G S passable, @ O T W impassable)");
         break;  // one problem per row is enough to find it
@@ -270,8 +251,8 @@ Result<Topology, Diagnostics> parse_movingai_map(std::string_view text, std::str
 
 Result<Topology, Diagnostics> load_movingai_map(const std::filesystem::path& path,
                                                 const MovingAiOptions& options) {
-  auto text = detail::read_text_file(path);
-  if (!text) return unexpected(std::move(text).error());
+  auto text = read_text_file(path);
+  if (!text) return unexpected(Diagnostics{{"", std::move(text).error().message}});
   return parse_movingai_map(*text, path.stem().string(), options);
 }
 
