@@ -167,8 +167,7 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
   const auto loaded = topology::load_movingai_map(arguments.map, map_options);
   if (!loaded) {
     for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << arguments.map << (problem.where.empty() ? "" : ":" + problem.where)
-                << ": " << problem.what << "\n";
+      std::cerr << "error: " << topology::diagnostic_text(arguments.map, problem) << "\n";
     }
     return cli::kExitBadInput;
   }

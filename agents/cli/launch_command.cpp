@@ -119,8 +119,7 @@ int run(const LaunchArguments& arguments) {
   auto file = launcher::load_launch_file(arguments.launch_file, state_dir->path());
   if (!file) {
     for (const auto& problem : file.error()) {
-      std::cerr << "error: " << arguments.launch_file << (problem.where.empty() ? "" : ": " + problem.where)
-                << ": " << problem.what << "\n";
+      std::cerr << "error: " << topology::diagnostic_text(arguments.launch_file, problem) << "\n";
     }
     return kExitBadInput;
   }

@@ -58,8 +58,7 @@ int run(LoadGeneratorArguments arguments) {
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
     for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << arguments.topology_file << (problem.where.empty() ? "" : ": " + problem.where)
-                << ": " << problem.what << "\n";
+      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
     }
     return kExitBadInput;
   }

@@ -42,9 +42,7 @@ int validate(const ValidateArguments& arguments) {
   if (!loaded) {
     const auto& problems = loaded.error();
     for (std::size_t i = 0; i < problems.size() && i < kMaxReportedProblems; ++i) {
-      std::cerr << "error: " << arguments.file
-                << (problems[i].where.empty() ? "" : ":" + problems[i].where) << ": "
-                << problems[i].what << "\n";
+      std::cerr << "error: " << topology::diagnostic_text(arguments.file, problems[i]) << "\n";
     }
     if (problems.size() > kMaxReportedProblems) {
       std::cerr << "error: " << arguments.file << ": " << problems.size() - kMaxReportedProblems

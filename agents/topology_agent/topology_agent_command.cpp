@@ -37,8 +37,7 @@ int run(const TopologyAgentArguments& arguments) {
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
     for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << arguments.topology_file << (problem.where.empty() ? "" : ": " + problem.where)
-                << ": " << problem.what << "\n";
+      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
     }
     return kExitBadInput;
   }

@@ -180,7 +180,7 @@ TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   EXPECT_TRUE(status->exited);
   EXPECT_EQ(status->code, 2);
   const auto err = read_file((dir / "err.txt").string());
-  EXPECT_NE(err.find("fleet.json: agents[1].at: 'atlantis' is not a vertex of"), std::string::npos) << err;
+  EXPECT_NE(err.find("fleet.json:agents[1].at: 'atlantis' is not a vertex of"), std::string::npos) << err;
   EXPECT_EQ(err.find("started"), std::string::npos) << err;
   std::filesystem::remove_all(dir);
 }

@@ -122,6 +122,10 @@ class Validator {
 
 }  // namespace
 
+std::string diagnostic_text(const std::string& file, const Diagnostic& problem) {
+  return file + (problem.where.empty() ? "" : ":" + problem.where) + ": " + problem.what;
+}
+
 TopologyBuilder::TopologyBuilder(std::string name, FootprintOptions options)
     : name_(std::move(name)), options_(options) {}
 

@@ -233,9 +233,8 @@ class LaunchFileParser {
     auto loaded = topology::load_topology_file(file_.topology_file);
     if (!loaded) {
       for (const auto& problem : loaded.error()) {
-        checker_.problem("topology", file_.topology_file.string() +
-                                         (problem.where.empty() ? "" : ": " + problem.where) +
-                                         ": " + problem.what);
+        checker_.problem("topology",
+                         topology::diagnostic_text(file_.topology_file.string(), problem));
       }
       return;
     }

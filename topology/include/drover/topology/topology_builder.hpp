@@ -21,6 +21,10 @@ struct Diagnostic {
 };
 using Diagnostics = std::vector<Diagnostic>;
 
+/// How every tool prints a problem in `file`: "FILE:WHERE: WHAT", or "FILE: WHAT" when the
+/// problem has no place (the file as a whole: missing, empty, a directory).
+std::string diagnostic_text(const std::string& file, const Diagnostic& problem);
+
 struct VertexSpec {
   std::string id;
   double x = 0;
