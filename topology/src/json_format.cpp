@@ -19,12 +19,25 @@ namespace {
 // Ordered, so that diagnostics follow the file and written files keep a readable order.
 using Json = nlohmann::ordered_json;
 
-std::string member(const std::string& where, std::string_view key) {
-  return where.empty() ? std::string(key) : where + "." + std::string(key);
+void append_member(std::string& where, std::string_view key) {
+  if (!where.empty()) where += '.';
+  where += key;
 }
 
-std::string element(const std::string& where, std::size_t index) {
-  return where + "[" + std::to_string(index) + "]";
+void append_element(std::string& where, std::size_t index) {
+  where += '[';
+  where += std::to_string(index);
+  where += ']';
+}
+
+std::string member(std::string where, std::string_view key) {
+  append_member(where, key);
+  return where;
+}
+
+std::string element(std::string where, std::size_t index) {
+  append_element(where, index);
+  return where;
 }
 
 /// Turns a parsed document into builder specs, collecting every structural problem (wrong
@@ -333,9 +346,7 @@ class DuplicateKeyWatch {
       case Event::key: {
         Frame& object = frames_.back();
         object.key = parsed.get<std::string>();
-        if (!object.keys.insert(object.key).second) {
-          duplicates_.push_back(Diagnostic{path(), "key given twice in the same object"});
-        }
+        if (!object.keys.insert(object.key).second) report_duplicate();
         break;
       }
       case Event::value:
@@ -357,17 +368,35 @@ class DuplicateKeyWatch {
     if (!frames_.empty() && !frames_.back().object) ++frames_.back().elements;
   }
 
+  /// Reports the key just read, by its path, up to kMaxNamed of them (each path is as long
+  /// as the nesting is deep: naming a duplicate at every level of a deeply nested file
+  /// took minutes), then counts the rest in one last diagnostic.
+  void report_duplicate() {
+    constexpr std::size_t kMaxNamed = 100;
+    if (duplicates_.size() < kMaxNamed) {
+      duplicates_.push_back(Diagnostic{path(), "key given twice in the same object"});
+      return;
+    }
+    ++unnamed_;
+    if (duplicates_.size() == kMaxNamed) duplicates_.push_back(Diagnostic{});
+    duplicates_.back().what = std::to_string(unnamed_) + " more keys given twice";
+  }
+
   std::string path() const {
     std::string where;
     for (const Frame& frame : frames_) {
-      where = frame.object ? member(where, frame.key)
-                           : element(where, frame.elements == 0 ? 0 : frame.elements - 1);
+      if (frame.object) {
+        append_member(where, frame.key);
+      } else {
+        append_element(where, frame.elements == 0 ? 0 : frame.elements - 1);
+      }
     }
     return where;
   }
 
   std::vector<Frame> frames_;
   Diagnostics duplicates_;
+  std::size_t unnamed_ = 0;  // duplicates found after kMaxNamed were named
 };
 
 /// nlohmann reports "[json.exception.parse_error.101] parse error at line 3, column 5:
