@@ -27,21 +27,22 @@ OutputFile::OutputFile(OutputFile&& other) noexcept
 
 Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
                                     const std::vector<std::filesystem::path>& inputs) {
+  std::filesystem::path partial = path;
+  partial += ".partial";
   for (const auto& input : inputs) {
-    if (same_file(path, input)) {
+    if (same_file(path, input) || same_file(partial, input)) {
       return fail(ErrorCode::invalid_argument,
-                  fmt::format("{}: is an input of this run; writing to it would overwrite it",
-                              path.string()));
+                  fmt::format("{}: it or {} is an input of this run; writing would overwrite it",
+                              path.string(), partial.string()));
     }
   }
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) {
     return fail(ErrorCode::invalid_argument, fmt::format("{}: is a directory", path.string()));
   }
-  std::filesystem::path partial = path;
-  partial += ".partial";
   OutputFile file(path, partial);
   if (!file.out_) {
+    file.done_ = true;  // whatever stands at `partial` is not this run's to remove
     return fail(ErrorCode::io,
                 fmt::format("{}: cannot open {} for writing", path.string(), partial.string()));
   }

@@ -14,8 +14,10 @@ namespace drover::bench {
 
 class OutputFile {
  public:
-  /// Opens `path`'s temporary file (`path` + ".partial"). Fails, naming the file, when it
-  /// cannot be created, or when `path` is one of `inputs` (it would overwrite them).
+  /// Opens `path`'s temporary file (`path` + ".partial"), replacing any file of that name.
+  /// Fails, naming the file, when it cannot be created, when `path` is a directory, or when
+  /// `path` or the temporary file is one of `inputs` (it would overwrite them). The file at
+  /// `path` is replaced, not written through: a link there becomes a plain file.
   static Result<OutputFile> open(const std::filesystem::path& path,
                                  const std::vector<std::filesystem::path>& inputs);
   OutputFile(OutputFile&& other) noexcept;

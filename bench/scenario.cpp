@@ -62,7 +62,9 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
       if (fields.size() != 2 || fields[0] != "version" || !parse_number(fields[1], version)) {
         return bad(line_number, fmt::format("expected \"version 1\", got {}", printable_excerpt(line)));
       }
-      if (version != 1) return bad(line_number, fmt::format("unsupported version {}", fields[1]));
+      if (version != 1) {
+        return bad(line_number, fmt::format("unsupported version {}", printable_excerpt(fields[1])));
+      }
       header_seen = true;
       continue;
     }

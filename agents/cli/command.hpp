@@ -40,8 +40,9 @@ struct CommandContext {
 /// Parses the command line into `app` and runs the chosen subcommand. Help and version
 /// requests print and exit 0; a parse error prints CLI11's message and gives kExitBadInput;
 /// an exception escaping a command (commands report expected failures themselves) prints
-/// "error: internal: ..." and gives kExitFailure, and so does output that could not be
-/// written to standard output. \return the exit code of the process.
+/// "error: internal: ..." and gives kExitFailure. Output that could not be written to
+/// standard output prints "error: cannot write to standard output" and fails the run
+/// (kExitFailure, unless the command had failed already). \return the exit code.
 int run_app(CLI::App& app, const CommandContext& context, int argc, char** argv);
 
 /// `drover topology ...` (validate and friends).

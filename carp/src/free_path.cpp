@@ -64,7 +64,7 @@ Result<FreePath> FreePathSearch::find(const VehicleProfile& vehicle, EntityIndex
     }
   }
   const Traversal& traversal = *m.traversals.get(graph, vehicle).traversal;
-  if (auto slow = traversal.too_slow(graph)) {
+  if (auto slow = traversal.too_slow(graph, vehicle.id)) {
     return fail(ErrorCode::invalid_argument, std::move(*slow));
   }
   m.begin();

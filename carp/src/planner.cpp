@@ -236,7 +236,7 @@ struct Planner::Impl {
                                *restriction_violation(topology().vertex(v).restrictions,
                                                       request.vehicle)));
     };
-    if (auto slow = traversal.too_slow(*graph)) {
+    if (auto slow = traversal.too_slow(*graph, request.vehicle.id)) {
       return error(PlanFailure::invalid_request, std::move(*slow));
     }
     if (!traversal.usable_vertex(request.start)) return restricted(request.start, "start vertex");

@@ -31,16 +31,19 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
     const double speed = std::min(vehicle.max_speed, arc.speed_limit);
     const double travel_ns = arc.length / speed * 1e9;
     const double clearance_ns = vehicle.length / speed * 1e9;
+    usable_arc_[a] = usable_vertex_[arc.to] &&
+                     !restriction_violation(topology.edge(arc.edge).restrictions, vehicle);
+    // Only an arc the vehicle may drive can make it too slow: the others' times are never
+    // added up.
     const double longer_ns = std::max(travel_ns, clearance_ns);
-    if (longer_ns > most_ns && (!too_slow_arc_ || longer_ns > too_slow_arc_->seconds * 1e9)) {
+    if (usable_arc_[a] && usable_vertex_[arc.from] && longer_ns > most_ns &&
+        (!too_slow_arc_ || longer_ns > too_slow_arc_->seconds * 1e9)) {
       too_slow_arc_ = SlowArc{a, longer_ns / 1e9};
     }
     // Clipped before the conversion, which is undefined beyond the integer's range.
     travel_[a] = std::max<DurationNs>(1, std::llround(std::min(travel_ns, most_ns)));
     clearance_[a] =
         std::max<DurationNs>(1, static_cast<DurationNs>(std::ceil(std::min(clearance_ns, most_ns))));
-    usable_arc_[a] = usable_vertex_[arc.to] &&
-                     !restriction_violation(topology.edge(arc.edge).restrictions, vehicle);
     if (usable_arc_[a]) {
       shortest = std::min(shortest, travel_[a]);
       longest = std::max(longest, travel_[a]);
@@ -57,14 +60,15 @@ Traversal::Traversal(const RoutingGraph& graph, const VehicleProfile& vehicle)
   uniform_ = shortest == kForever || shortest == longest;
 }
 
-std::optional<std::string> Traversal::too_slow(const RoutingGraph& graph) const {
+std::optional<std::string> Traversal::too_slow(const RoutingGraph& graph,
+                                               const std::string& vehicle_id) const {
   if (!too_slow_arc_) return std::nullopt;
   const topology::Topology& topology = graph.topology();
   return fmt::format(
       "vehicle '{}' is too slow (or too long) for topology '{}': it would take {:.6g} s to "
       "drive or clear edge '{}', more than the {:.6g} s allowed per arc on {} vertices (so "
       "that no route's times overflow)",
-      vehicle_.id, topology.name(), too_slow_arc_->seconds,
+      vehicle_id, topology.name(), too_slow_arc_->seconds,
       topology.id(graph.arc(too_slow_arc_->arc).edge),
       ns_to_seconds(max_arc_time(graph.vertex_count())), graph.vertex_count());
 }

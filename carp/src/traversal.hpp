@@ -43,11 +43,12 @@ class Traversal {
   static DurationNs max_arc_time(std::size_t vertex_count) {
     return kLatestTime / static_cast<DurationNs>(std::max<std::size_t>(vertex_count, 1));
   }
-  /// Why the vehicle cannot be planned for on `graph` (the one it was built for), if so:
-  /// on some arc its travel or clearance would pass max_arc_time (a vehicle far too slow,
-  /// or too long). Such an arc's times are clipped to that bound, so a search must refuse
-  /// the vehicle rather than use them.
-  std::optional<std::string> too_slow(const RoutingGraph& graph) const;
+  /// Why vehicle `vehicle_id` (of this class) cannot be planned for on `graph` (the one
+  /// the traversal was built for), if so: on some arc it may drive, its travel or clearance
+  /// would pass max_arc_time (a vehicle far too slow, or too long). Such an arc's times are
+  /// clipped to that bound, so a search must refuse the vehicle rather than use them.
+  std::optional<std::string> too_slow(const RoutingGraph& graph,
+                                      const std::string& vehicle_id) const;
   /// Every usable arc takes the same time (a grid with one speed): shortest paths by time
   /// are shortest by arc count.
   bool uniform() const { return uniform_; }

@@ -551,6 +551,12 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   // is free would otherwise all be expanded first, in order of a bound that cannot be met.
   arrival_floor_ = arrival_floor(input);
   if (arrival_floor_ == kForever) return outcome;  // the stop can never be entered and held
+  // No route arrives by the deadline; and the proofs, which count from the floor, could
+  // overflow near kForever.
+  if (arrival_floor_ > input.deadline) {
+    outcome.horizon_cut = true;
+    return outcome;
+  }
   const DurationNs start_estimate = estimate(input, 0, input.start);
   if (start_estimate == kUnreachable) return outcome;
   improve(states_of(input, 0, input.start) + start_window_,

@@ -38,7 +38,7 @@ TEST(Scenario, ReportsTheLineAndWhatIsWrong) {
     const char* message;
   } cases[] = {
       {"", "s.scen:1: empty file"},
-      {"version 2\n", "s.scen:1: unsupported version 2"},
+      {"version 2\n", "s.scen:1: unsupported version '2'"},
       {"3\tm.map\t8\t8\t0\t0\t1\t1\t2\n", "s.scen:1: expected \"version 1\""},
       {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\n", "s.scen:2: expected 9 fields"},
       {"version 1\n0\tm.map\t8\t8\tx\t0\t1\t1\t2\n", "s.scen:2: start x 'x' is not"},

@@ -159,14 +159,19 @@ TEST(MovingAi, ShortFilesAndBadOptionsAreReported) {
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.cell_size", "at least 0.01"));
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.max_speed", "positive"));
 
-  // 1 001 cells of 1 km reach past the coordinates a topology allows.
+  // 1 001 cells of 1 km reach past the coordinates a topology allows; the size the error
+  // suggests fits.
+  const std::string wide_map =
+      "type octile\nheight 1\nwidth 1001\nmap\n" + std::string(1001, '.') + "\n";
   MovingAiOptions wide;
   wide.cell_size = 1000;
-  const auto too_wide = parse_movingai_map(
-      "type octile\nheight 1\nwidth 1001\nmap\n" + std::string(1001, '.') + "\n", "x", wide);
+  const auto too_wide = parse_movingai_map(wide_map, "x", wide);
   ASSERT_FALSE(too_wide.has_value());
-  EXPECT_TRUE(has_diagnostic(too_wide.error(), "options.cell_size", "at most 999.001"))
+  EXPECT_TRUE(has_diagnostic(too_wide.error(), "options.cell_size", "at most 999.500"))
       << dump(too_wide.error());
+  wide.cell_size = 999.5;
+  const auto fits = parse_movingai_map(wide_map, "x", wide);
+  EXPECT_TRUE(fits.has_value()) << dump(fits.error());
 }
 
 TEST(MovingAi, MutatedInputNeverCrashes) {

@@ -270,7 +270,7 @@ TEST(TopologyBuilder, RefusesCoordinatesAndSizesWhereFootprintsLoseTheirArea) {
   ab.length = 1e300;
   builder.add_edge(ab);
   auto bc = edge("bc", "b", "c");
-  bc.footprint = axis_aligned_rectangle(0, -1e6, 1e6 + 1, -1e6 + 1);
+  bc.footprint = axis_aligned_rectangle(0, -1e6, kMaxCornerCoordinate + 1, -1e6 + 1);
   builder.add_edge(bc);
 
   const Diagnostics diagnostics = build_errors(std::move(builder));
@@ -282,7 +282,7 @@ TEST(TopologyBuilder, RefusesCoordinatesAndSizesWhereFootprintsLoseTheirArea) {
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[0].x", "within 1000000 m")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].y", "within 1000000 m")) << all;
   EXPECT_TRUE(has_diagnostic(diagnostics, "edges[0].length", "at most 10000000")) << all;
-  EXPECT_TRUE(has_diagnostic(diagnostics, "edges[1].footprint", "more than 1000000 m")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "edges[1].footprint", "more than 1010000 m")) << all;
   EXPECT_EQ(diagnostics.size(), 6u) << all;
 }
 
@@ -300,6 +300,25 @@ TEST(TopologyBuilder, TheSmallestGeneratedFootprintsStillConflictOnOneSpot) {
     ASSERT_TRUE(built.has_value()) << dump(built.error());
     EXPECT_EQ(built->conflict_pair_count(), 1u) << "disc " << disc;
   }
+}
+
+// Agents pass a topology on with its generated footprints written out (a routing agent
+// rebuilds it from the topology agents' descriptions): those at the edge of the coordinates
+// must read back as given footprints.
+TEST(TopologyBuilder, GeneratedFootprintsAtTheLimitReadBackAsGiven) {
+  FootprintOptions options;
+  options.vertex_radius = kMaxFootprintOption;
+  TopologyBuilder generated("edge-of-map", options);
+  generated.add_vertex(vertex("a", kMaxCoordinate, -kMaxCoordinate));
+  auto first = std::move(generated).build();
+  ASSERT_TRUE(first.has_value()) << dump(first.error());
+
+  TopologyBuilder given("edge-of-map");
+  auto a = vertex("a", kMaxCoordinate, -kMaxCoordinate);
+  a.footprint = first->vertex(0).footprint;
+  given.add_vertex(a);
+  auto second = std::move(given).build();
+  EXPECT_TRUE(second.has_value()) << dump(second.error());
 }
 
 TEST(TopologyBuilder, EdgeBetweenVerticesTooCloseForAFootprintIsReported) {

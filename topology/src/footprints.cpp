@@ -85,8 +85,9 @@ std::optional<std::string> normalize_footprint(Polygon& polygon) {
     if (!std::isfinite(corner.x()) || !std::isfinite(corner.y())) {
       return "a corner has a non-finite coordinate";
     }
-    if (std::abs(corner.x()) > kMaxCoordinate || std::abs(corner.y()) > kMaxCoordinate) {
-      return "a corner lies more than 1000000 m (kMaxCoordinate) from the origin";
+    if (std::abs(corner.x()) > kMaxCornerCoordinate ||
+        std::abs(corner.y()) > kMaxCornerCoordinate) {
+      return "a corner lies more than 1010000 m from the origin on an axis";
     }
   }
   if (!polygon.inners().empty()) return "holes are not supported";

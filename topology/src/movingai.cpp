@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <iomanip>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -191,12 +192,17 @@ Result<Topology, Diagnostics> build_grid(const Grid& grid, std::string name,
                                          const MovingAiOptions& options) {
   const double cell = options.cell_size;
   const double half = cell / 2;
-  // The far corner of the last cell must stay within the coordinates a topology allows.
+  // The last cell's centre (a vertex) must stay within the coordinates a topology allows,
+  // and its footprint, half a cell further, with it.
   const int side = std::max(grid.width, grid.height);
-  if (side * cell > kMaxCoordinate) {
+  const double far_corner = (side - 0.5) * cell;
+  if (far_corner > kMaxCoordinate) {
+    // Rounded down, so that the size suggested passes.
+    const double largest = std::floor(kMaxCoordinate / (side - 0.5) * 1000) / 1000;
     std::ostringstream what;
-    what << "must be at most " << kMaxCoordinate / side << " (metres) for a map " << side
-         << " cells wide: its cells must lie within 1000000 m (kMaxCoordinate) of the origin";
+    what << std::fixed << std::setprecision(3) << "must be at most " << largest
+         << " (metres) for a map " << side
+         << " cells wide or high: its cells must lie within 1000000 m of the origin";
     return unexpected(Diagnostics{{"options.cell_size", what.str()}});
   }
   const auto open = [&grid](int x, int y) {

@@ -58,7 +58,7 @@ class Validator {
     if (!std::isfinite(value)) {
       report(where, "must be finite");
     } else if (std::abs(value) > kMaxCoordinate) {
-      report(where, "must lie within 1000000 m (kMaxCoordinate) of the origin");
+      report(where, "must lie within 1000000 m of the origin");
     }
   }
 

@@ -17,8 +17,9 @@ namespace drover::carp {
 /// longest horizon the planner takes (about 73 years; a longer horizon is cut to it), so
 /// that its sums of times never overflow.
 inline constexpr TimeNs kLatestTime = kForever / 4;
-/// The most stops one request may have.
-inline constexpr std::size_t kMaxStops = 65536;
+/// The most stops one request may have: a search keeps a little for every (stop, vertex)
+/// pair, 8 bytes, so 1 024 stops on a map of 100 000 vertices take 800 MB.
+inline constexpr std::size_t kMaxStops = 1024;
 
 /// A vertex the route must reach, in request order.
 struct Stop {

@@ -40,11 +40,10 @@ inline constexpr int kMaxDiscPoints = 256;
 /// Footprints smaller than this (m^2) are treated as empty.
 inline constexpr double kMinFootprintArea = 1e-6;
 
-/// How far (m) from the origin a vertex or a footprint's corner may lie. A plant fits many
-/// times over, and at this scale a double resolves positions to well below a micrometre,
-/// so footprints and their overlaps keep their area (far out, two vertices a few metres
-/// apart, or two tiny squares on one spot, would round to the same corners and stop
-/// conflicting).
+/// How far (m) from the origin, on each axis, a vertex may lie. A plant fits many times
+/// over, and at this scale a double resolves positions to well below a micrometre, so
+/// footprints and their overlaps keep their area (far out, two vertices a few metres apart,
+/// or two tiny squares on one spot, would round to the same corners and stop conflicting).
 inline constexpr double kMaxCoordinate = 1e6;
 
 /// The range (m) of `vertex_radius` and `edge_half_width`: at the least, a generated
@@ -53,12 +52,17 @@ inline constexpr double kMaxCoordinate = 1e6;
 inline constexpr double kMinFootprintOption = 0.01;
 inline constexpr double kMaxFootprintOption = 1e4;
 
+/// How far (m) from the origin, on each axis, a footprint's corner may lie: as far as a
+/// generated footprint of a vertex within kMaxCoordinate reaches, so that a topology
+/// written out with its generated footprints reads back (as agents pass it on).
+inline constexpr double kMaxCornerCoordinate = kMaxCoordinate + kMaxFootprintOption;
+
 /// The longest length (m) an edge may be given: more than any two points within
 /// kMaxCoordinate lie apart.
 inline constexpr double kMaxEdgeLength = 1e7;
 
 /// Corrects `polygon` in place (orientation, closing point) and checks that it can serve
-/// as a footprint: corners within kMaxCoordinate of the origin on both axes, valid per
+/// as a footprint: corners within kMaxCornerCoordinate of the origin on each axis, valid per
 /// boost::geometry::is_valid (no self-intersection, no spikes, at least three distinct
 /// corners), no holes, area of at least kMinFootprintArea.
 /// \return nullopt when it is usable, otherwise the reason it is not.

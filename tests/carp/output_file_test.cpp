@@ -1,0 +1,92 @@
+// bench/output_file: an output file appears whole or not at all, and never over an input.
+
+#include "bench/output_file.hpp"
+
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+namespace drover::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+class OutputFileTest : public ::testing::Test {
+ protected:
+  OutputFileTest()
+      : dir_(fs::temp_directory_path() / ("drover-output-file-test-" + std::to_string(::getpid()))) {
+    fs::create_directories(dir_);
+  }
+  ~OutputFileTest() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+  }
+  std::string read(const std::string& name) const {
+    std::ifstream in(path(name));
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(OutputFileTest, ACommittedFileReplacesTheOldOneAndLeavesNoPartial) {
+  write("out.jsonl", "old\n");
+  auto file = OutputFile::open(path("out.jsonl"), {});
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  file->stream() << "new\n";
+  EXPECT_EQ(read("out.jsonl"), "old\n") << "replaced only on commit";
+  ASSERT_TRUE(file->commit().has_value());
+  EXPECT_EQ(read("out.jsonl"), "new\n");
+  EXPECT_FALSE(fs::exists(path("out.jsonl.partial")));
+}
+
+TEST_F(OutputFileTest, AFileNeverCommittedLeavesTheOldOneAndRemovesItsPartial) {
+  write("out.jsonl", "old\n");
+  {
+    auto file = OutputFile::open(path("out.jsonl"), {});
+    ASSERT_TRUE(file.has_value()) << file.error().message;
+    OutputFile moved = std::move(file).value();  // the moved-from one removes nothing
+    moved.stream() << "half a li";
+    EXPECT_TRUE(fs::exists(path("out.jsonl.partial")));
+  }
+  EXPECT_EQ(read("out.jsonl"), "old\n");
+  EXPECT_FALSE(fs::exists(path("out.jsonl.partial")));
+}
+
+TEST_F(OutputFileTest, NeverOverAnInputNorItsPartialName) {
+  write("tasks.scen", "version 1\n");
+  write("tasks.partial", "version 1\n");
+  const auto over_input = OutputFile::open(path("tasks.scen"), {path("tasks.scen")});
+  ASSERT_FALSE(over_input.has_value());
+  EXPECT_NE(over_input.error().message.find("is an input"), std::string::npos);
+  const auto over_partial = OutputFile::open(path("tasks"), {path("tasks.partial")});
+  ASSERT_FALSE(over_partial.has_value());
+  EXPECT_EQ(read("tasks.scen"), "version 1\n");
+  EXPECT_EQ(read("tasks.partial"), "version 1\n");
+}
+
+TEST_F(OutputFileTest, WhatStandsAtThePartialNameIsNotRemovedWhenItCannotBeOpened) {
+  fs::create_directories(path("out.jsonl.partial"));
+  const auto file = OutputFile::open(path("out.jsonl"), {});
+  ASSERT_FALSE(file.has_value());
+  EXPECT_NE(file.error().message.find("cannot open"), std::string::npos) << file.error().message;
+  EXPECT_TRUE(fs::is_directory(path("out.jsonl.partial")));
+}
+
+TEST_F(OutputFileTest, ADirectoryIsRefused) {
+  fs::create_directories(path("out"));
+  const auto file = OutputFile::open(path("out"), {});
+  ASSERT_FALSE(file.has_value());
+  EXPECT_NE(file.error().message.find("is a directory"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace drover::bench
