@@ -23,7 +23,7 @@ OutputFile::OutputFile(OutputFile&& other) noexcept
     : path_(std::move(other.path_)),
       partial_(std::move(other.partial_)),
       out_(std::move(other.out_)),
-      done_(std::exchange(other.done_, true)) {}
+      done_(std::exchange(other.done_, true)) {}  // only one of them may remove the file
 
 Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
                                     const std::vector<std::filesystem::path>& inputs) {

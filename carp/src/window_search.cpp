@@ -198,6 +198,12 @@ WindowSearch::FloorProof WindowSearch::raise_arrival_floor(const SearchInput& in
       arrival_floor_ = kForever;
       return FloorProof::no_route;
     }
+    // The floor stays within the deadline (run() checks the first): past it no route can
+    // arrive in time, and the next proof, counting from the floor, could overflow.
+    if (proof.margin > input.deadline - arrival_floor_) {
+      arrival_floor_ = input.deadline + 1;  // a lower bound still: floor + margin is above
+      return FloorProof::past_deadline;
+    }
     arrival_floor_ += proof.margin;
   }
   if (arrival_floor_ == floor) {
@@ -552,7 +558,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
   arrival_floor_ = arrival_floor(input);
   if (arrival_floor_ == kForever) return outcome;  // the stop can never be entered and held
   // No route arrives by the deadline; and the proofs, which count from the floor, could
-  // overflow near kForever.
+  // overflow near kForever. (raise_arrival_floor keeps it so.)
   if (arrival_floor_ > input.deadline) {
     outcome.horizon_cut = true;
     return outcome;
@@ -579,6 +585,7 @@ SearchOutcome WindowSearch::run(const SearchInput& input) {
       }
       if (proof != FloorProof::go_on) {
         outcome.found = proof == FloorProof::route_found;
+        outcome.horizon_cut = proof == FloorProof::past_deadline;
         return outcome;
       }
       if (top.f < arrival_floor_) {  // the key rose: back to the open list

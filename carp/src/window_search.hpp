@@ -61,7 +61,8 @@ struct SearchInput {
 struct SearchOutcome {
   bool found = false;
   bool start_free = false;     ///< the start vertex was free at the start time
-  bool horizon_cut = false;    ///< some state was dropped for passing the deadline
+  /// A state was dropped for passing the deadline, or the arrival floor passed it.
+  bool horizon_cut = false;
 };
 
 class WindowSearch {
@@ -145,6 +146,7 @@ class WindowSearch {
     go_on,        ///< the floor rose, or stayed: the search goes on
     no_route,     ///< no route ever arrives (a certificate of failure)
     route_found,  ///< a route arrives at the floor, the earliest possible: it is in path_
+    past_deadline,  ///< the floor passed the deadline: no route arrives in time
   };
   /// Whether prove_late applies: one stop, held open-ended (the proofs search back from its
   /// open-ended window).

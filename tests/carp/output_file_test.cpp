@@ -53,7 +53,7 @@ TEST_F(OutputFileTest, AFileNeverCommittedLeavesTheOldOneAndRemovesItsPartial) {
   {
     auto file = OutputFile::open(path("out.jsonl"), {});
     ASSERT_TRUE(file.has_value()) << file.error().message;
-    OutputFile moved = std::move(file).value();  // the moved-from one removes nothing
+    OutputFile moved = std::move(file).value();  // the one that removes the partial
     moved.stream() << "half a li";
     EXPECT_TRUE(fs::exists(path("out.jsonl.partial")));
   }

@@ -78,6 +78,20 @@ TEST(PlannerLimits, AHoldNearForeverIsBeyondTheHorizon) {
   EXPECT_TRUE(held.has_value()) << held.error().message;
 }
 
+// A floor proof that raises the floor past the deadline ends the search, cut by the
+// horizon (proofs after every floor-keyed expansion, so that one runs at once).
+TEST(PlannerLimits, AFloorRaisedPastTheDeadlineEndsTheSearch) {
+  World w(GridBuilder().corridor(4).build(),
+          PlannerOptions{.horizon = sec(10), .quick_proof_after = 1, .floor_proof_after = 1});
+  w.occupy("b", "3,0", 0, sec(5));   // the goal is free for good from 5 s: the first floor
+  w.occupy("c", "1,0", 0, sec(20));  // but the way there opens only at 20 s
+  const PlanError error = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "3,0")}));
+  EXPECT_EQ(error.reason, PlanFailure::no_window) << error.message;
+  EXPECT_TRUE(mentions(error, "within the horizon of 10.000 s")) << error.message;
+  EXPECT_GT(w.planner.last_stats().arrival_floor, sec(10));
+  EXPECT_GE(w.planner.last_stats().floor_proofs, 1u);
+}
+
 TEST(PlannerLimits, AVehicleTooSlowForTheGraphIsRefusedNotPlannedAtTopSpeed) {
   World w(GridBuilder().corridor(3).build());
   PlanRequest slow = request_to(w, "a", "0,0", {open_stop(w, "2,0")});

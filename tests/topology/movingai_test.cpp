@@ -159,17 +159,17 @@ TEST(MovingAi, ShortFilesAndBadOptionsAreReported) {
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.cell_size", "at least 0.01"));
   EXPECT_TRUE(has_diagnostic(bad_options.error(), "options.max_speed", "positive"));
 
-  // 1 001 cells of 1 km reach past the coordinates a topology allows; the size the error
-  // suggests fits.
+  // The 1 002nd cell's centre, at 1 km a cell, lies past the coordinates a topology allows;
+  // the size the error suggests fits.
   const std::string wide_map =
-      "type octile\nheight 1\nwidth 1001\nmap\n" + std::string(1001, '.') + "\n";
+      "type octile\nheight 1\nwidth 1002\nmap\n" + std::string(1002, '.') + "\n";
   MovingAiOptions wide;
   wide.cell_size = 1000;
   const auto too_wide = parse_movingai_map(wide_map, "x", wide);
   ASSERT_FALSE(too_wide.has_value());
-  EXPECT_TRUE(has_diagnostic(too_wide.error(), "options.cell_size", "at most 999.500"))
+  EXPECT_TRUE(has_diagnostic(too_wide.error(), "options.cell_size", "at most 999.000"))
       << dump(too_wide.error());
-  wide.cell_size = 999.5;
+  wide.cell_size = 999.0;
   const auto fits = parse_movingai_map(wide_map, "x", wide);
   EXPECT_TRUE(fits.has_value()) << dump(fits.error());
 }

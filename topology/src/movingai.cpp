@@ -193,15 +193,15 @@ Result<Topology, Diagnostics> build_grid(const Grid& grid, std::string name,
   const double cell = options.cell_size;
   const double half = cell / 2;
   // The last cell's centre (a vertex) must stay within the coordinates a topology allows,
-  // and its footprint, half a cell further, with it.
+  // and its footprint, half a cell further, within those of corners.
   const int side = std::max(grid.width, grid.height);
-  const double far_corner = (side - 0.5) * cell;
-  if (far_corner > kMaxCoordinate) {
-    // Rounded down, so that the size suggested passes.
-    const double largest = std::floor(kMaxCoordinate / (side - 0.5) * 1000) / 1000;
+  double largest = kMaxCornerCoordinate / (side - 0.5);
+  if (side > 1) largest = std::min(largest, kMaxCoordinate / (side - 1));
+  if (cell > largest) {
     std::ostringstream what;
-    what << std::fixed << std::setprecision(3) << "must be at most " << largest
-         << " (metres) for a map " << side
+    // Rounded down, so that the size suggested passes.
+    what << std::fixed << std::setprecision(3) << "must be at most "
+         << std::floor(largest * 1000) / 1000 << " (metres) for a map " << side
          << " cells wide or high: its cells must lie within 1000000 m of the origin";
     return unexpected(Diagnostics{{"options.cell_size", what.str()}});
   }
