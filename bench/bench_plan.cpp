@@ -325,7 +325,7 @@ void add_bench_plan_command(CLI::App& bench, cli::CommandContext& context) {
           "FILE"));
   plan->add_option("--repeat", arguments->repeat,
                    "Run the whole measurement this many times and report median times")
-      ->check(CLI::Range(1, 100));
+      ->check(cli::whole_in(1, 100));
   plan->callback([arguments, &context] {
     try {
       context.exit_code = run_plan_bench(*arguments);

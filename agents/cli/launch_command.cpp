@@ -227,7 +227,7 @@ void add_launch_command(CLI::App& app, CommandContext& context) {
                       "Shared-clock seconds per real second (overrides the launch file's)")
       ->check(cli::positive());
   command->add_option("--domain", arguments->domain_id, "DDS domain id (overrides the launch file's)")
-      ->check(CLI::Range(0, 232));
+      ->check(cli::whole_in(0, 232));
   command->add_option("--trace", arguments->trace_file,
                       "Write every RAN status, topology event and order change as JSON lines");
   command->add_option("--state-dir", arguments->state_dir,

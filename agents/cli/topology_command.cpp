@@ -72,7 +72,7 @@ void add_topology_commands(CLI::App& app, CommandContext& context) {
   validate_command
       ->add_option("--cell-size", arguments->cell_size,
                    "Side of a grid cell in metres, 0.01 to 1000 (.map files; default 1)")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(cli::number_in(0.01, 1000.0));
   validate_command->callback([arguments, &context] {
     try {
       context.exit_code = validate(*arguments);

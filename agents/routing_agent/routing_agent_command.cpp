@@ -75,7 +75,7 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
   auto* command = app.add_subcommand(
       "routing-agent", "Serve routes (test and real) planned with CARP, reserved through the topology agents");
   command->add_option("--id", arguments->agent_id, "Agent id (default: routing)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
@@ -84,7 +84,7 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
       ->check(cli::positive());
   command->add_option("--max-attempts", arguments->max_attempts,
                       "Plan/prepare rounds of a real route before ERROR_CONFLICT (default 5)")
-      ->check(CLI::Range(1, 100));
+      ->check(cli::whole_in(1, 100));
   command->add_option("--learn-timeout", arguments->learn_timeout_seconds,
                       "Seconds a request waits for the descriptions it needs (default 3)")
       ->check(cli::positive());

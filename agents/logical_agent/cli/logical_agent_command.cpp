@@ -107,12 +107,12 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
                       "Vehicle profile JSON (max_speed, acceleration, deceleration, length, width, ...)")
       ->check(CLI::ExistingFile);
   command->add_option("--ran-id", arguments->ran_agent, "The RAN's agent id (default: ran-<id>)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
   command->add_option("--lookahead", arguments->lookahead, "Vertices allocated ahead of the vehicle (default 2)")
-      ->check(CLI::Range(1, 1000));
+      ->check(cli::whole_in(1, 1000));
   command->add_option("--delay-threshold", arguments->delay_threshold,
                       "s of lateness at the next vertex before a delay is propagated (default 2)")
       ->check(cli::positive());
@@ -120,7 +120,7 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
                       "s idle before driving to a parking vertex; negative: never (default 30)");
   command->add_option("--charge-below", arguments->charge_below,
                       "State of charge under which it charges before new work; 0: never (default 0.2)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(cli::number_in(0.0, 1.0));
   command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at (default 0.9)");
   command->add_option("--error-limit", arguments->error_limit,
                       "s a recoverable RAN error may last before the order fails (default 60)")

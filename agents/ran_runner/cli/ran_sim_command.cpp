@@ -147,14 +147,14 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--at", arguments->at_vertex, "The vertex the vehicle starts at")->required();
   sim->add_option("--heading", arguments->heading,
                   "Start heading in radians (default: the vertex orientation, else 0)");
-  sim->add_option("--domain", arguments->domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  sim->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
   sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)");
   sim->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*sim, arguments->clock);
   sim->add_option("--status-period-ms", arguments->status_period_ms,
                   "Real milliseconds between status reports (default 100)")
-      ->check(CLI::Range(1, 60000));
+      ->check(cli::whole_in(1, 60000));
   sim->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   auto& vehicle = arguments->vehicle;
   sim->add_option("--max-speed", vehicle.max_speed, "m/s (default 1)");
