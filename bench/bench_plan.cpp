@@ -164,7 +164,7 @@ nlohmann::json steps_json(const topology::Topology& topology, const Route& route
 int run_plan_bench(const PlanBenchArguments& arguments) {
   const auto logger = make_agent_logger("bench-plan");
   topology::MovingAiOptions map_options;  // 1 m cells, 1 m/s edges
-  const auto loaded = topology::load_movingai_map(arguments.map, map_options);
+  const auto loaded = topology::load_movingai_grid(arguments.map, map_options);
   if (!loaded) {
     for (const auto& problem : loaded.error()) {
       std::cerr << "error: " << topology::diagnostic_text(arguments.map, problem) << "\n";
@@ -181,12 +181,19 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
               << " but the scenario has only " << tasks->size() << " tasks\n";
     return cli::kExitBadInput;
   }
-  const topology::Topology& map = *loaded;
+  const topology::Topology& map = loaded->topology;
   const std::string map_name = std::filesystem::path(arguments.map).filename().string();
 
   std::vector<Agent> agents;
   for (std::size_t i = 0; i < arguments.agents; ++i) {
     const ScenarioTask& task = (*tasks)[i];
+    // Cells are named by their coordinates: on a map of another size they name other cells.
+    if (task.map_width != loaded->width || task.map_height != loaded->height) {
+      std::cerr << "error: " << arguments.scenario << ":" << task.line << ": the task is for a "
+                << task.map_width << "x" << task.map_height << " map, but " << arguments.map
+                << " is " << loaded->width << "x" << loaded->height << " (width x height)\n";
+      return cli::kExitBadInput;
+    }
     if (task.map != map_name) {
       logger->warn("{}:{}: the task is for map {}, running it on {}", arguments.scenario,
                    task.line, printable_excerpt(task.map), map_name);

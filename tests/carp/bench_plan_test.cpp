@@ -157,6 +157,9 @@ TEST_F(BenchPlan, PrintsOneJsonLineAndWritesEveryAgentsSteps) {
 TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
   write("short.scen", "version 1\n0\tring.map\t6\t3\t0\t0\t5\n");
   write("wall.scen", "version 1\n0\tring.map\t6\t3\t1\t1\t5\t2\t7\n");
+  // Made for a wider map: its cells would name other cells here.
+  write("wide.scen", "version 1\n0\tring.map\t6\t3\t0\t0\t5\t2\t7\n"
+                     "0\tring.map\t8\t3\t0\t0\t5\t2\t7\n");
   const struct {
     std::vector<std::string> arguments;
     std::string message;
@@ -167,6 +170,9 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
        path("short.scen") + ":2: expected 9 fields"},
       {{"--map", path("ring.map"), "--scen", path("wall.scen"), "--agents", "1"},
        path("wall.scen") + ":2: start cell is not a passable cell"},
+      {{"--map", path("ring.map"), "--scen", path("wide.scen"), "--agents", "2"},
+       path("wide.scen") + ":3: the task is for a 8x3 map, but " + path("ring.map") +
+           " is 6x3 (width x height)"},
       {{"--map", path("missing.map"), "--scen", path("ring.scen"), "--agents", "1"},
        path("missing.map")},
       {{"--map", path("ring.map"), "--scen", path("missing.scen"), "--agents", "1"},

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <random>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -106,6 +109,20 @@ TEST_F(SmallMap, FootprintsMakeTurnsConflictButNotStraightOrParallelMoves) {
   EXPECT_FALSE(in_conflict("2,1-3,1", "2,2-3,2"));  // parallel neighbours
   EXPECT_FALSE(in_conflict("2,2", "3,2"));          // neighbouring cells
   EXPECT_FALSE(in_conflict("2,1", "2,2-3,2"));
+}
+
+TEST(MovingAi, TheGridKeepsTheHeadersSizeWhereBorderCellsAreBlocked) {
+  // A blocked last column and row leave no vertex there, yet scenarios name the header's size.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("drover-movingai-grid-" + std::to_string(::getpid()) + ".map");
+  std::ofstream(path) << "type octile\nheight 3\nwidth 4\nmap\n...@\n...@\n@@@@\n";
+  const auto loaded = load_movingai_grid(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(loaded.has_value()) << dump(loaded.error());
+  EXPECT_EQ(loaded->width, 4);
+  EXPECT_EQ(loaded->height, 3);
+  EXPECT_EQ(loaded->topology.vertex_count(), 6u);
+  EXPECT_EQ(loaded->topology.name(), path.stem().string());
 }
 
 TEST(MovingAi, AcceptsWindowsLineEndings) {

@@ -188,8 +188,8 @@ Diagnostics check_options(const MovingAiOptions& options) {
   return problems;
 }
 
-Result<Topology, Diagnostics> build_grid(const Grid& grid, std::string name,
-                                         const MovingAiOptions& options) {
+Result<MovingAiGrid, Diagnostics> build_grid(const Grid& grid, std::string name,
+                                             const MovingAiOptions& options) {
   const double cell = options.cell_size;
   const double half = cell / 2;
   // The last cell's centre (a vertex) must stay within the coordinates a topology allows,
@@ -239,13 +239,13 @@ Result<Topology, Diagnostics> build_grid(const Grid& grid, std::string name,
       }
     }
   }
-  return std::move(builder).build();
+  auto topology = std::move(builder).build();
+  if (!topology) return unexpected(std::move(topology).error());
+  return MovingAiGrid{std::move(topology).value(), grid.width, grid.height};
 }
 
-}  // namespace
-
-Result<Topology, Diagnostics> parse_movingai_map(std::string_view text, std::string name,
-                                                 const MovingAiOptions& options) {
+Result<MovingAiGrid, Diagnostics> parse_movingai_grid(std::string_view text, std::string name,
+                                                      const MovingAiOptions& options) {
   if (auto problems = check_options(options); !problems.empty()) {
     return unexpected(std::move(problems));
   }
@@ -255,11 +255,28 @@ Result<Topology, Diagnostics> parse_movingai_map(std::string_view text, std::str
   return build_grid(*grid, std::move(name), options);
 }
 
-Result<Topology, Diagnostics> load_movingai_map(const std::filesystem::path& path,
-                                                const MovingAiOptions& options) {
+Result<Topology, Diagnostics> only_topology(Result<MovingAiGrid, Diagnostics> grid) {
+  if (!grid) return unexpected(std::move(grid).error());
+  return std::move(grid->topology);
+}
+
+}  // namespace
+
+Result<Topology, Diagnostics> parse_movingai_map(std::string_view text, std::string name,
+                                                 const MovingAiOptions& options) {
+  return only_topology(parse_movingai_grid(text, std::move(name), options));
+}
+
+Result<MovingAiGrid, Diagnostics> load_movingai_grid(const std::filesystem::path& path,
+                                                     const MovingAiOptions& options) {
   auto text = read_text_file(path);
   if (!text) return unexpected(Diagnostics{{"", std::move(text).error().message}});
-  return parse_movingai_map(*text, path.stem().string(), options);
+  return parse_movingai_grid(*text, path.stem().string(), options);
+}
+
+Result<Topology, Diagnostics> load_movingai_map(const std::filesystem::path& path,
+                                                const MovingAiOptions& options) {
+  return only_topology(load_movingai_grid(path, options));
 }
 
 }  // namespace drover::topology

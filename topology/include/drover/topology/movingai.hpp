@@ -35,6 +35,19 @@ struct MovingAiOptions {
   std::string partition = "main";
 };
 
+/// An imported map with the size its header gives (a scenario names the size it was made
+/// for; the topology alone cannot tell it when a border row or column is blocked).
+struct MovingAiGrid {
+  Topology topology;
+  int width = 0;   ///< cells per row
+  int height = 0;  ///< rows
+};
+
+/// Imports the map at `path` with its size; the topology is named after the file's stem.
+/// \return as load_movingai_map.
+Result<MovingAiGrid, Diagnostics> load_movingai_grid(const std::filesystem::path& path,
+                                                     const MovingAiOptions& options = {});
+
 /// Imports the map at `path`; the topology is named after the file's stem.
 /// \return the topology, or every problem found: an unreadable or empty file (where ""),
 ///         header problems, rows of the wrong count or length and unknown characters
