@@ -5,14 +5,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drover/common/json_syntax.hpp"
+
 namespace drover::carp {
 
 Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where) {
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    return fail(ErrorCode::parse, where + ": not valid JSON: " + e.what());
+  } catch (const nlohmann::json::exception& error) {
+    const auto syntax = json_syntax_error(text, error);
+    const std::string at = syntax.where.empty() ? where : where + ":" + syntax.where;
+    return fail(ErrorCode::parse, at + ": " + syntax.what);
   }
   if (!json.is_object()) return fail(ErrorCode::parse, where + ": a vehicle profile is a JSON object");
   VehicleProfile vehicle;

@@ -87,7 +87,12 @@ TEST(LaunchFile, GoodFileBecomesCommandLines) {
 }
 
 TEST(LaunchFile, NotJsonOrNotAnObject) {
-  EXPECT_NE(problems_of("{\"agents\": [").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(problems_of("{\"agents\": [").find("malformed JSON"), std::string::npos);
+  // A number beyond double range is bad input with its place, not an internal error.
+  EXPECT_NE(problems_of("{\"name\": \"x\",\n \"domain\": 1e400}")
+                .find("line 2, column 16: malformed JSON: number overflow parsing '1e400'"),
+            std::string::npos)
+      << problems_of("{\"name\": \"x\",\n \"domain\": 1e400}");
   EXPECT_NE(problems_of("[1, 2]").find("must be a JSON object"), std::string::npos);
 }
 

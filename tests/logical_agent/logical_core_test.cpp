@@ -275,6 +275,11 @@ TEST(VehicleProfileJson, ParsesAndNamesBadFields) {
   ASSERT_FALSE(range);
   EXPECT_EQ(range.error().code, ErrorCode::invalid_argument);
   EXPECT_FALSE(carp::parse_vehicle_profile("{", "v.json"));
+  auto huge = carp::parse_vehicle_profile(R"({"max_speed": 1e400})", "v.json");
+  ASSERT_FALSE(huge);
+  EXPECT_EQ(huge.error().code, ErrorCode::parse);
+  EXPECT_EQ(huge.error().message,
+            "v.json:line 1, column 19: malformed JSON: number overflow parsing '1e400'");
   EXPECT_EQ(carp::read_vehicle_profile("/nonexistent/v.json").error().code, ErrorCode::io);
 }
 

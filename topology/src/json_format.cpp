@@ -1,5 +1,6 @@
 #include "drover/topology/json_format.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/topology/footprints.hpp"
 
@@ -399,19 +401,6 @@ class DuplicateKeyWatch {
   std::size_t unnamed_ = 0;  // duplicates found after kMaxNamed were named
 };
 
-/// nlohmann reports "[json.exception.parse_error.101] parse error at line 3, column 5:
-/// syntax error ..."; split that into where ("line 3, column 5") and what.
-Diagnostic parse_failure(const nlohmann::json::parse_error& error) {
-  const std::string message = error.what();
-  constexpr std::string_view kAt = "parse error at ";
-  const auto at = message.find(kAt);
-  const auto colon = at == std::string::npos ? std::string::npos : message.find(": ", at);
-  if (colon == std::string::npos) return Diagnostic{"", message};
-  const auto place_start = at + kAt.size();
-  return Diagnostic{message.substr(place_start, colon - place_start),
-                    "malformed JSON: " + message.substr(colon + 2)};
-}
-
 Json point_json(const Point& point) { return Json::array({point.x(), point.y()}); }
 
 Json footprint_json(const Polygon& footprint) {
@@ -502,11 +491,9 @@ Result<Topology, Diagnostics> parse_topology_json(std::string_view text) {
   DuplicateKeyWatch watch;
   try {
     document = Json::parse(text.begin(), text.end(), std::ref(watch));
-  } catch (const nlohmann::json::parse_error& error) {
-    return unexpected(Diagnostics{parse_failure(error)});
   } catch (const nlohmann::json::exception& error) {
-    // Numbers beyond double range are reported as out_of_range, without a position.
-    return unexpected(Diagnostics{Diagnostic{"", std::string("malformed JSON: ") + error.what()}});
+    auto syntax = json_syntax_error(text, error);
+    return unexpected(Diagnostics{Diagnostic{std::move(syntax.where), std::move(syntax.what)}});
   }
   if (!watch.duplicates().empty()) return unexpected(std::move(watch.duplicates()));
   SpecReader reader;

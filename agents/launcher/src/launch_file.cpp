@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drover/common/json_syntax.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/topology/topology_file.hpp"
 
@@ -155,8 +156,9 @@ class LaunchFileParser {
     Json root;
     try {
       root = Json::parse(text);
-    } catch (const Json::parse_error& error) {
-      checker_.problem("", std::string("not valid JSON: ") + error.what());
+    } catch (const Json::exception& error) {
+      auto syntax = json_syntax_error(text, error);
+      checker_.problem(std::move(syntax.where), std::move(syntax.what));
       return unexpected(checker_.take());
     }
     if (!root.is_object()) {
