@@ -67,6 +67,8 @@ struct AstarRun {
 };
 
 constexpr topology::RouteId kRoute = 1;
+// More agents than any MovingAI scenario holds (at most a few thousand tasks).
+constexpr long long kMaxAgents = 1'000'000;
 
 /// A monotonic clock, in seconds. Read around every plan, so it must cost next to nothing
 /// and leave the caches alone: the thread's CPU clock (CLOCK_THREAD_CPUTIME_ID) is a system
@@ -185,28 +187,34 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
   const std::string map_name = std::filesystem::path(arguments.map).filename().string();
 
   std::vector<Agent> agents;
+  std::size_t other_map_tasks = 0;
   for (std::size_t i = 0; i < arguments.agents; ++i) {
     const ScenarioTask& task = (*tasks)[i];
     // Cells are named by their coordinates: on a map of another size they name other cells.
     if (task.map_width != loaded->width || task.map_height != loaded->height) {
-      std::cerr << "error: " << arguments.scenario << ":" << task.line << ": the task is for a "
+      std::cerr << "error: " << arguments.scenario << ":line " << task.line << ": the task is for a "
                 << task.map_width << "x" << task.map_height << " map, but " << arguments.map
                 << " is " << loaded->width << "x" << loaded->height << " (width x height)\n";
       return cli::kExitBadInput;
     }
-    if (task.map != map_name) {
-      logger->warn("{}:{}: the task is for map {}, running it on {}", arguments.scenario,
+    // Said once, for the first such task: a renamed copy of the map would repeat it N times.
+    if (task.map != map_name && other_map_tasks++ == 0) {
+      logger->warn("{}:line {}: the task is for map {}, running it on {}", arguments.scenario,
                    task.line, printable_excerpt(task.map), map_name);
     }
     const auto start = map.find(fmt::format("{},{}", task.start_x, task.start_y));
     const auto goal = map.find(fmt::format("{},{}", task.goal_x, task.goal_y));
     if (!start || !goal) {
-      std::cerr << "error: " << arguments.scenario << ":" << task.line << ": "
+      std::cerr << "error: " << arguments.scenario << ":line " << task.line << ": "
                 << (!start ? "start" : "goal") << " cell is not a passable cell of "
                 << arguments.map << "\n";
       return cli::kExitBadInput;
     }
     agents.push_back(Agent{fmt::format("agent-{}", i), *start, *goal});
+  }
+  if (other_map_tasks > 1) {
+    logger->warn("{}: {} of the {} tasks run are for another map than {}", arguments.scenario,
+                 other_map_tasks, agents.size(), map_name);
   }
 
   // Opened once the input is checked, before any work: a paths file that cannot be
@@ -319,20 +327,20 @@ void add_bench_plan_command(CLI::App& bench, cli::CommandContext& context) {
       "Plan the first N tasks of a MovingAI scenario one after another as real CARP routes "
       "from time 0 (goals held open-ended) and time it against a reservation-free A* on the "
       "same start/goal pairs; prints one JSON line");
-  plan->add_option("--map", arguments->map, "MovingAI .map file")->required();
-  plan->add_option("--scen", arguments->scenario, "MovingAI .scen file")->required();
+  plan->add_option("--map", arguments->map, "MovingAI .map file")->required()->check(cli::non_empty());
+  plan->add_option("--scen", arguments->scenario, "MovingAI .scen file")
+      ->required()
+      ->check(cli::non_empty());
   plan->add_option("--agents", arguments->agents, "How many scenario tasks to plan (N >= 1)")
       ->required()
-      ->check(cli::positive());
+      ->transform(cli::whole_in(1, kMaxAgents));
   plan->add_option("--paths", arguments->paths,
                    "Also write one JSON line per agent with its steps to this file (written "
                    "as FILE.partial, renamed when complete)")
-      ->check(CLI::Validator(
-          [](std::string& path) { return path.empty() ? std::string("must not be empty") : ""; },
-          "FILE"));
+      ->check(cli::non_empty());
   plan->add_option("--repeat", arguments->repeat,
                    "Run the whole measurement this many times and report median times")
-      ->check(cli::whole_in(1, 100));
+      ->transform(cli::whole_in(1, 100));
   plan->callback([arguments, &context] {
     try {
       context.exit_code = run_plan_bench(*arguments);

@@ -1,5 +1,7 @@
 #include "bench/output_file.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <system_error>
 #include <utility>
 
@@ -40,11 +42,17 @@ Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
   if (std::filesystem::is_directory(path, error)) {
     return fail(ErrorCode::invalid_argument, fmt::format("{}: is a directory", path.string()));
   }
+  // A link at the temporary name is replaced, not written through to the file it names.
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(partial, error))) {
+    std::filesystem::remove(partial, error);
+  }
+  errno = 0;
   OutputFile file(path, partial);
   if (!file.out_) {
     file.done_ = true;  // whatever stands at `partial` is not this run's to remove
-    return fail(ErrorCode::io,
-                fmt::format("{}: cannot open {} for writing", path.string(), partial.string()));
+    return fail(ErrorCode::io, fmt::format("{}: cannot open {} for writing: {}", path.string(),
+                                           partial.string(),
+                                           errno != 0 ? std::strerror(errno) : "unknown error"));
   }
   return file;
 }

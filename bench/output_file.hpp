@@ -14,7 +14,8 @@ namespace drover::bench {
 
 class OutputFile {
  public:
-  /// Opens `path`'s temporary file (`path` + ".partial"), replacing any file of that name.
+  /// Opens `path`'s temporary file (`path` + ".partial"), replacing any file of that name
+  /// (a symbolic link there is replaced too, never written through).
   /// Fails, naming the file, when it cannot be created, when `path` is a directory, or when
   /// `path` or the temporary file is one of `inputs` (it would overwrite them). The file at
   /// `path` is replaced, not written through: a link there becomes a plain file.

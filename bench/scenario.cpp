@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -44,7 +46,7 @@ std::string_view trim(std::string_view s) {
 Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const std::string& name) {
   std::vector<ScenarioTask> tasks;
   const auto bad = [&name](int line, const std::string& what) {
-    return fail(ErrorCode::parse, fmt::format("{}:{}: {}", name, line, what));
+    return fail(ErrorCode::parse, fmt::format("{}:line {}: {}", name, line, what));
   };
   std::size_t position = 0;
   int line_number = 0;
@@ -87,12 +89,14 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
                     {"goal y", fields[7], &task.goal_y}};
     for (const auto& field : integers) {
       if (!parse_number(field.text, *field.value) || *field.value < 0) {
-        return bad(line_number, fmt::format("{} {} is not a non-negative integer", field.what,
-                                            printable_excerpt(field.text)));
+        return bad(line_number, fmt::format("{} {} is not a whole number from 0 to {}", field.what,
+                                            printable_excerpt(field.text),
+                                            std::numeric_limits<int>::max()));
       }
     }
-    if (!parse_number(fields[8], task.optimal_length) || !(task.optimal_length >= 0)) {
-      return bad(line_number, fmt::format("optimal length {} is not a non-negative number",
+    if (!parse_number(fields[8], task.optimal_length) || !std::isfinite(task.optimal_length) ||
+        task.optimal_length < 0) {
+      return bad(line_number, fmt::format("optimal length {} is not a finite number >= 0",
                                           printable_excerpt(fields[8])));
     }
     if (task.start_x >= task.map_width || task.goal_x >= task.map_width ||

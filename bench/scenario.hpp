@@ -24,7 +24,7 @@ struct ScenarioTask {
 };
 
 /// Parses scenario text; `name` prefixes error messages.
-/// \return the tasks in file order, or a parse error "NAME:LINE: what is wrong".
+/// \return the tasks in file order, or a parse error "NAME:line N: what is wrong".
 Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const std::string& name);
 
 /// Reads and parses a scenario file. \return the tasks, or io / parse errors naming the file.

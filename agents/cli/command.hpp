@@ -2,11 +2,9 @@
 // Every agent and tool is a subcommand of the one `drover` executable. Each subcommand
 // registers itself on the CLI11 app and reports its exit code through CommandContext.
 
-#include <cmath>
-#include <sstream>
-#include <string>
-
 #include <CLI/CLI.hpp>
+
+#include "agents/cli/number_checks.hpp"
 
 namespace drover::cli {
 
@@ -18,51 +16,13 @@ enum ExitCode : int {
   kExitNoAnswer = 3,    ///< no agent answered
 };
 
-/// CLI11 checks of a number's sign with plain messages ("must be > 0, got 0"): CLI11's own
-/// PositiveNumber and NonNegativeNumber name a range from 0 to 1.8e308 instead.
-inline CLI::Validator sign_check(bool zero_allowed) {
+/// The option's text must not be empty (an empty file name would be reported as a file
+/// named "", which no message makes clear).
+inline CLI::Validator non_empty() {
   return CLI::Validator(
-      [zero_allowed](std::string& input) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value)) return "'" + input + "' is not a number";
-        const bool fine = zero_allowed ? value >= 0 : value > 0;
-        return fine ? std::string() : std::string(zero_allowed ? "must be >= 0" : "must be > 0") +
-                                          ", got " + input;
-      },
-      zero_allowed ? "NONNEGATIVE" : "POSITIVE");
+      [](std::string& text) { return text.empty() ? std::string("must not be empty") : std::string(); },
+      "");
 }
-/// The number must be > 0.
-inline CLI::Validator positive() { return sign_check(false); }
-/// The number must be >= 0.
-inline CLI::Validator non_negative() { return sign_check(true); }
-
-/// The number must lie in [low, high], and be whole when `whole`. Plain messages ("'abc' is
-/// not a number", "must be a whole number, got 1.5", "must be from 1 to 100, got 0"):
-/// CLI11's Range says "Value abc not in range 1 to 100" for all three, and lets NaN pass.
-inline CLI::Validator range_check(double low, double high, bool whole) {
-  const auto text = [](double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-  };
-  return CLI::Validator(
-      [=](std::string& input) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value)) return "'" + input + "' is not a number";
-        if (whole && value != std::floor(value)) return "must be a whole number, got " + input;
-        const bool fine = value >= low && value <= high;  // false for NaN
-        return fine ? std::string()
-                    : "must be from " + text(low) + " to " + text(high) + ", got " + input;
-      },
-      whole ? "INT in [" + text(low) + " - " + text(high) + "]"
-            : "FLOAT in [" + text(low) + " - " + text(high) + "]");
-}
-/// A whole number in [low, high].
-inline CLI::Validator whole_in(long long low, long long high) {
-  return range_check(static_cast<double>(low), static_cast<double>(high), true);
-}
-/// A number in [low, high].
-inline CLI::Validator number_in(double low, double high) { return range_check(low, high, false); }
 
 /// Filled in by the subcommand that ran.
 struct CommandContext {

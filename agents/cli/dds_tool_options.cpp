@@ -9,9 +9,9 @@ namespace drover::cli {
 void add_dds_tool_options(CLI::App& command, DdsToolOptions& options, double default_timeout_seconds) {
   options.timeout_seconds = default_timeout_seconds;
   command.add_option("--domain", options.domain_id, "DDS domain id of the agents (default 0)")
-      ->check(cli::whole_in(0, 232));
+      ->transform(cli::whole_in(0, 232));
   command.add_option("--timeout", options.timeout_seconds, "Seconds to wait for agents to answer")
-      ->check(cli::positive())
+      ->transform(cli::positive())
       ->capture_default_str();
   command.add_option("--xml-profile", options.xml_profile, "Fast DDS XML profiles file (transports, security)")
       ->check(CLI::ExistingFile);

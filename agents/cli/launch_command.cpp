@@ -222,19 +222,19 @@ void add_launch_command(CLI::App& app, CommandContext& context) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--duration", arguments->duration_s, "Stop after this many simulated seconds")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--time-factor", arguments->time_factor,
                       "Shared-clock seconds per real second (overrides the launch file's)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--domain", arguments->domain_id, "DDS domain id (overrides the launch file's)")
-      ->check(cli::whole_in(0, 232));
+      ->transform(cli::whole_in(0, 232));
   command->add_option("--trace", arguments->trace_file,
                       "Write every RAN status, topology event and order change as JSON lines");
   command->add_option("--state-dir", arguments->state_dir,
                       "Directory of relative journal paths (default: a temporary one, removed at the end)");
   command->add_option("--stop-grace", arguments->stop_grace_s,
                       "Real seconds an agent gets to end after SIGTERM before SIGKILL (default 5)")
-      ->check(cli::non_negative());
+      ->transform(cli::non_negative());
   command->add_option("--log-level", arguments->log_level, "The launcher's own log level (default warn)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });

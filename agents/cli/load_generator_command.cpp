@@ -129,7 +129,7 @@ void add_load_generator_command(CLI::App& app, CommandContext& context) {
   command->add_option("--max-orders", arguments->generator.max_orders,
                       "Stop sending after this many orders (default 0: never)");
   command->add_option("--id", arguments->agent_id, "Agent id; orders are named <id>-<n> (default load-generator)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);

@@ -149,7 +149,7 @@ void add_order_command(CLI::App& app, CommandContext& context) {
   send_command->add_option("--name", arguments->name, "The order's unique name (default: <vehicle>-<time>)");
   send_command->add_option("--wait", arguments->wait_seconds,
                            "Also wait up to S seconds for the order to finish (exit 1 if it fails)")
-      ->check(cli::non_negative());
+      ->transform(cli::non_negative());
   add_dds_tool_options(*send_command, arguments->dds, 5.0);
   send_command->callback([arguments, &context] { context.exit_code = send(*arguments); });
 }

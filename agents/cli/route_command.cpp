@@ -127,7 +127,7 @@ void add_route_command(CLI::App& app, CommandContext& context) {
                       "Shared-clock start time, ns (default: now on the routing agent's clock)");
   command->add_option("--dwell", arguments->dwell_seconds,
                       "Hold the destination this many seconds (default: open-ended, until the next route)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--for", arguments->owner, "Agent the route is for (default: droverctl-<pid>)");
   add_dds_tool_options(*command, arguments->dds, 5.0);
   command->callback([arguments, &context] { context.exit_code = run_route(*arguments); });

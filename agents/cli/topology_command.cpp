@@ -68,11 +68,11 @@ void add_topology_commands(CLI::App& app, CommandContext& context) {
       "validate",
       "Load a topology file (.json: Drover format, .map: MovingAI grid map), check it and "
       "print a one-line summary; exit 2 with one line per problem if it is invalid");
-  validate_command->add_option("FILE", arguments->file, "The topology file")->required();
+  validate_command->add_option("FILE", arguments->file, "The topology file")->required()->check(cli::non_empty());
   validate_command
       ->add_option("--cell-size", arguments->cell_size,
                    "Side of a grid cell in metres, 0.01 to 1000 (.map files; default 1)")
-      ->check(cli::number_in(0.01, 1000.0));
+      ->transform(cli::number_in(0.01, 1000.0));
   validate_command->callback([arguments, &context] {
     try {
       context.exit_code = validate(*arguments);

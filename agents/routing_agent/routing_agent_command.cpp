@@ -75,22 +75,22 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
   auto* command = app.add_subcommand(
       "routing-agent", "Serve routes (test and real) planned with CARP, reserved through the topology agents");
   command->add_option("--id", arguments->agent_id, "Agent id (default: routing)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
   command->add_option("--prepare-ttl", arguments->prepare_ttl_seconds,
                       "Shared-clock seconds a prepared hold lives before it expires (default 5)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--max-attempts", arguments->max_attempts,
                       "Plan/prepare rounds of a real route before ERROR_CONFLICT (default 5)")
-      ->check(cli::whole_in(1, 100));
+      ->transform(cli::whole_in(1, 100));
   command->add_option("--learn-timeout", arguments->learn_timeout_seconds,
                       "Seconds a request waits for the descriptions it needs (default 3)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--horizon", arguments->horizon_seconds,
                       "Planning horizon after the start time, seconds (default 3600)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_flag("--hold-after-prepare", arguments->hold_after_prepare,
                     "TEST HOOK: prepare real routes but never commit them (log a marker and wait)");
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")

@@ -86,7 +86,7 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
                       "Serve only the entities of this partition (default: all)");
   command->add_option("--db", arguments->journal_file,
                       "SQLite journal: restored on start, written after every change (default: none)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--id", arguments->agent_id,
                       "Agent id (default: topology-<partition>, or topology)");
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")

@@ -5,21 +5,34 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <system_error>
 
 namespace drover {
 
 Result<std::string> read_text_file(const std::filesystem::path& path) {
   std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return fail(ErrorCode::io, "is a directory");
+  const auto type = std::filesystem::status(path, error).type();
+  if (type == std::filesystem::file_type::directory) return fail(ErrorCode::io, "is a directory");
+  // A device never ends (/dev/zero, /dev/urandom) or waits on a terminal; pipes stay
+  // allowed, for process substitution.
+  if (type == std::filesystem::file_type::character || type == std::filesystem::file_type::block ||
+      type == std::filesystem::file_type::socket) {
+    return fail(ErrorCode::io, "is a device or socket, not a file");
+  }
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     return fail(ErrorCode::io, std::string("cannot open: ") +
                                    (errno != 0 ? std::strerror(errno) : "unknown error"));
   }
-  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    if (text.size() + static_cast<std::size_t>(in.gcount()) > kMaxTextFileBytes) {
+      return fail(ErrorCode::io, "larger than " + std::to_string(kMaxTextFileBytes >> 20) + " MiB");
+    }
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+  }
   if (in.bad()) return fail(ErrorCode::io, "cannot read: I/O error");
   if (text.empty()) return fail(ErrorCode::io, "file is empty");
   return text;

@@ -167,18 +167,18 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "4"},
        "but the scenario has only 3 tasks"},
       {{"--map", path("ring.map"), "--scen", path("short.scen"), "--agents", "1"},
-       path("short.scen") + ":2: expected 9 fields"},
+       path("short.scen") + ":line 2: expected 9 fields"},
       {{"--map", path("ring.map"), "--scen", path("wall.scen"), "--agents", "1"},
-       path("wall.scen") + ":2: start cell is not a passable cell"},
+       path("wall.scen") + ":line 2: start cell is not a passable cell"},
       {{"--map", path("ring.map"), "--scen", path("wide.scen"), "--agents", "2"},
-       path("wide.scen") + ":3: the task is for a 8x3 map, but " + path("ring.map") +
+       path("wide.scen") + ":line 3: the task is for a 8x3 map, but " + path("ring.map") +
            " is 6x3 (width x height)"},
       {{"--map", path("missing.map"), "--scen", path("ring.scen"), "--agents", "1"},
        path("missing.map")},
       {{"--map", path("ring.map"), "--scen", path("missing.scen"), "--agents", "1"},
        path("missing.scen")},
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "0"},
-       "--agents: must be > 0, got 0"},
+       "--agents: must be from 1 to 1000000, got 0"},
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "two"},
        "--agents: 'two' is not a number"},
       // Refused before the run: no result line for output that could not be written.
@@ -192,6 +192,10 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
        path("ring.scen") + ": it or " + path("ring.scen") + ".partial is an input of this run"},
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1", "--paths", ""},
        "--paths: must not be empty"},
+      {{"--map", "", "--scen", path("ring.scen"), "--agents", "1"}, "--map: must not be empty"},
+      {{"--map", path("ring.map"), "--scen", "", "--agents", "1"}, "--scen: must not be empty"},
+      {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "010"},
+       "but the scenario has only 3 tasks"},  // ten, not octal eight
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.message);

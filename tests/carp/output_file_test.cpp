@@ -77,8 +77,21 @@ TEST_F(OutputFileTest, WhatStandsAtThePartialNameIsNotRemovedWhenItCannotBeOpene
   fs::create_directories(path("out.jsonl.partial"));
   const auto file = OutputFile::open(path("out.jsonl"), {});
   ASSERT_FALSE(file.has_value());
-  EXPECT_NE(file.error().message.find("cannot open"), std::string::npos) << file.error().message;
+  EXPECT_NE(file.error().message.find("for writing: Is a directory"), std::string::npos)
+      << "says why: " << file.error().message;
   EXPECT_TRUE(fs::is_directory(path("out.jsonl.partial")));
+}
+
+TEST_F(OutputFileTest, ALinkAtThePartialNameIsReplacedNotWrittenThrough) {
+  write("precious.txt", "keep me\n");
+  fs::create_symlink(path("precious.txt"), path("out.jsonl.partial"));
+  auto file = OutputFile::open(path("out.jsonl"), {});
+  ASSERT_TRUE(file.has_value()) << file.error().message;
+  file->stream() << "new\n";
+  ASSERT_TRUE(file->commit().has_value());
+  EXPECT_EQ(read("precious.txt"), "keep me\n");
+  EXPECT_EQ(read("out.jsonl"), "new\n");
+  EXPECT_FALSE(fs::is_symlink(path("out.jsonl")));
 }
 
 TEST_F(OutputFileTest, ADirectoryIsRefused) {

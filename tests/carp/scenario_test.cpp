@@ -37,16 +37,20 @@ TEST(Scenario, ReportsTheLineAndWhatIsWrong) {
     const char* text;
     const char* message;
   } cases[] = {
-      {"", "s.scen:1: empty file"},
-      {"version 2\n", "s.scen:1: unsupported version '2'"},
-      {"3\tm.map\t8\t8\t0\t0\t1\t1\t2\n", "s.scen:1: expected \"version 1\""},
-      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\n", "s.scen:2: expected 9 fields"},
-      {"version 1\n0\tm.map\t8\t8\tx\t0\t1\t1\t2\n", "s.scen:2: start x 'x' is not"},
-      {"version 1\n0\tm.map\t8\t8\t-1\t0\t1\t1\t2\n", "s.scen:2: start x '-1' is not"},
-      {"version 1\n0\tm.map\t8\t8\t0\t0\t8\t1\t2\n", "s.scen:2: start (0,0) or goal (8,1) lies"},
-      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\tfar\n", "s.scen:2: optimal length 'far'"},
+      {"", "s.scen:line 1: empty file"},
+      {"version 2\n", "s.scen:line 1: unsupported version '2'"},
+      {"3\tm.map\t8\t8\t0\t0\t1\t1\t2\n", "s.scen:line 1: expected \"version 1\""},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\n", "s.scen:line 2: expected 9 fields"},
+      {"version 1\n0\tm.map\t8\t8\tx\t0\t1\t1\t2\n", "s.scen:line 2: start x 'x' is not"},
+      {"version 1\n0\tm.map\t8\t8\t-1\t0\t1\t1\t2\n", "s.scen:line 2: start x '-1' is not"},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t8\t1\t2\n", "s.scen:line 2: start (0,0) or goal (8,1) lies"},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\tfar\n", "s.scen:line 2: optimal length 'far'"},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\tinf\n",
+       "s.scen:line 2: optimal length 'inf' is not a finite number >= 0"},
+      {"version 1\n0\tm.map\t8\t8\t0\t0\t99999999999\t1\t2\n",
+       "s.scen:line 2: goal x '99999999999' is not a whole number from 0 to 2147483647"},
       // The file's bytes are quoted safely: escapes shown, not sent to the terminal.
-      {"version 1\x1b[31mRED\n", "s.scen:1: expected \"version 1\", got 'version 1\\x1B[31mRED'"},
+      {"version 1\x1b[31mRED\n", "s.scen:line 1: expected \"version 1\", got 'version 1\\x1B[31mRED'"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.text);

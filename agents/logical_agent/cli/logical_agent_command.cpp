@@ -107,27 +107,27 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
                       "Vehicle profile JSON (max_speed, acceleration, deceleration, length, width, ...)")
       ->check(CLI::ExistingFile);
   command->add_option("--ran-id", arguments->ran_agent, "The RAN's agent id (default: ran-<id>)");
-  command->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
+  command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
   command->add_option("--lookahead", arguments->lookahead, "Vertices allocated ahead of the vehicle (default 2)")
-      ->check(cli::whole_in(1, 1000));
+      ->transform(cli::whole_in(1, 1000));
   command->add_option("--delay-threshold", arguments->delay_threshold,
                       "s of lateness at the next vertex before a delay is propagated (default 2)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--park-after", arguments->park_after,
                       "s idle before driving to a parking vertex; negative: never (default 30)");
   command->add_option("--charge-below", arguments->charge_below,
                       "State of charge under which it charges before new work; 0: never (default 0.2)")
-      ->check(cli::number_in(0.0, 1.0));
+      ->transform(cli::number_in(0.0, 1.0));
   command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at (default 0.9)");
   command->add_option("--error-limit", arguments->error_limit,
                       "s a recoverable RAN error may last before the order fails (default 60)")
-      ->check(cli::positive());
+      ->transform(cli::positive());
   command->add_option("--route-limit", arguments->route_limit,
                       "s to keep asking for a route the timelines or locks refuse (default 120)")
-      ->check(cli::non_negative());
+      ->transform(cli::non_negative());
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }

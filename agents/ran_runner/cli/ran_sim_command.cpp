@@ -147,14 +147,14 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--at", arguments->at_vertex, "The vertex the vehicle starts at")->required();
   sim->add_option("--heading", arguments->heading,
                   "Start heading in radians (default: the vertex orientation, else 0)");
-  sim->add_option("--domain", arguments->domain_id, "DDS domain id")->check(cli::whole_in(0, 232));
+  sim->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)");
   sim->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*sim, arguments->clock);
   sim->add_option("--status-period-ms", arguments->status_period_ms,
                   "Real milliseconds between status reports (default 100)")
-      ->check(cli::whole_in(1, 60000));
+      ->transform(cli::whole_in(1, 60000));
   sim->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   auto& vehicle = arguments->vehicle;
   sim->add_option("--max-speed", vehicle.max_speed, "m/s (default 1)");
@@ -166,9 +166,9 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--drain", vehicle.drain_wh_per_metre, "Wh per metre driven (default 0.5)");
   sim->add_option("--charge-rate", vehicle.charge_wh_per_second, "Wh per second charging (default 1)");
   sim->add_option("--load-duration", arguments->load_seconds, "s (default 5)")
-      ->check(cli::non_negative());
+      ->transform(cli::non_negative());
   sim->add_option("--unload-duration", arguments->unload_seconds, "s (default 5)")
-      ->check(cli::non_negative());
+      ->transform(cli::non_negative());
   sim->add_option("--custom-action", arguments->custom_actions,
                   "A custom action the vehicle supports: NAME=SECONDS (repeatable)");
   sim->add_flag("--loaded", arguments->loaded, "Start loaded");

@@ -1,0 +1,25 @@
+#pragma once
+// Checks of numeric command-line options, with plain messages, that also fix how a number
+// is read: decimal only. CLI11 converts integers with base detection, so "010" would be 8
+// and "0x0A" 10 while the check had read 10 and refused 0x0A; each check rewrites the text
+// it accepted into the plain decimal that CLI11 then converts to the value checked.
+// Add them with Option::transform: Option::check hands a validator a copy of the text.
+
+#include <CLI/CLI.hpp>
+
+namespace drover::cli {
+
+/// The number must be finite and > 0 ("must be > 0, got 0"; CLI11's PositiveNumber names a
+/// range from 0 to 1.8e308 instead).
+CLI::Validator positive();
+/// The number must be finite and >= 0.
+CLI::Validator non_negative();
+
+/// A whole number in [low, high] ("'abc' is not a number", "must be a whole number, got
+/// 1.5", "must be from 1 to 100, got 0"; CLI11's Range says "not in range" to all three and
+/// lets NaN pass). \pre low <= high, both within +-2^53 (exact as doubles).
+CLI::Validator whole_in(long long low, long long high);
+/// A finite number in [low, high].
+CLI::Validator number_in(double low, double high);
+
+}  // namespace drover::cli

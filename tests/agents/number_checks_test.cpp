@@ -1,0 +1,77 @@
+// The numeric option checks every tool shares: decimal only, plain messages, and the value
+// the option receives is the one checked.
+
+#include "agents/cli/number_checks.hpp"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace drover::cli {
+namespace {
+
+/// Parses `--n VALUE` into an option of type T transformed by `check`. \return the error
+/// message, or "" with `value` set.
+template <class T>
+std::string parse(const std::string& text, CLI::Validator check, T& value) {
+  CLI::App app;
+  app.add_option("--n", value)->transform(std::move(check));
+  std::vector<std::string> arguments{text, "--n"};  // CLI11 takes them in reverse order
+  try {
+    app.parse(arguments);
+  } catch (const CLI::ParseError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(NumberChecks, WholeNumbersAreReadAsDecimalsWhateverTheirLeadingZeros) {
+  std::size_t count = 0;
+  EXPECT_EQ(parse("010", whole_in(1, 100), count), "");
+  EXPECT_EQ(count, 10u) << "not octal";
+  EXPECT_EQ(parse("1e2", whole_in(1, 100), count), "");
+  EXPECT_EQ(count, 100u);
+  EXPECT_EQ(parse("+7", whole_in(1, 100), count), "");
+  EXPECT_EQ(count, 7u);
+  int domain = -1;
+  EXPECT_EQ(parse("007", whole_in(0, 232), domain), "");
+  EXPECT_EQ(domain, 7);
+}
+
+TEST(NumberChecks, OtherNotationsAreNotNumbers) {
+  std::size_t count = 0;
+  for (const char* text : {"0x0A", "0b11", "abc", "inf", "nan", "1e", " 3", "", "1,5"}) {
+    SCOPED_TRACE(text);
+    EXPECT_NE(parse(text, whole_in(1, 100), count).find("is not a number"), std::string::npos);
+    double seconds = 0;
+    EXPECT_NE(parse(text, positive(), seconds).find("is not a number"), std::string::npos);
+  }
+}
+
+TEST(NumberChecks, RangesAndSignsAreNamedWithTheValueAsGiven) {
+  std::size_t count = 0;
+  EXPECT_NE(parse("1.5", whole_in(1, 100), count).find("must be a whole number, got 1.5"),
+            std::string::npos);
+  EXPECT_NE(parse("0", whole_in(1, 100), count).find("must be from 1 to 100, got 0"),
+            std::string::npos);
+  EXPECT_NE(parse("99999999999999999999", whole_in(1, 1000000), count)
+                .find("must be from 1 to 1000000, got 99999999999999999999"),
+            std::string::npos)
+      << "not clamped to the type's largest value";
+  double seconds = 0;
+  EXPECT_NE(parse("0", positive(), seconds).find("must be > 0, got 0"), std::string::npos);
+  EXPECT_NE(parse("-0.5", non_negative(), seconds).find("must be >= 0, got -0.5"),
+            std::string::npos);
+  EXPECT_NE(parse("1e400", number_in(0.01, 1000), seconds).find("is not a number"),
+            std::string::npos);
+  EXPECT_EQ(parse("0.25", number_in(0.01, 1000), seconds), "");
+  EXPECT_DOUBLE_EQ(seconds, 0.25);
+  EXPECT_EQ(parse("1e-3", positive(), seconds), "");
+  EXPECT_DOUBLE_EQ(seconds, 0.001);
+  EXPECT_EQ(parse("-0", non_negative(), seconds), "");
+  EXPECT_EQ(seconds, 0.0);
+}
+
+}  // namespace
+}  // namespace drover::cli
