@@ -29,58 +29,62 @@ PlanError error(PlanFailure reason, std::string message) {
   return PlanError{reason, std::move(message), {}};
 }
 
+std::string lock_text(const topology::Topology& topology, EntityIndex place,
+                      const topology::Lock& lock) {
+  return fmt::format("lock {} on '{}' [{}, {}) by {}: {}", lock.id, topology.id(place),
+                     time_text(lock.window.start), time_text(lock.window.end), lock.operator_id,
+                     lock.reason);
+}
+
+/// A reservation as it blocks `place` (its own entity, or one it shadows).
+std::string reservation_text(const topology::Topology& topology, EntityIndex place,
+                             const topology::Reservation& r) {
+  return fmt::format("agent {} route {} holds '{}'{} [{}, {})", r.agent, r.route,
+                     topology.id(r.origin),
+                     r.shadow() ? fmt::format(" (conflicting with '{}')", topology.id(place))
+                                : std::string(),
+                     time_text(r.window.start), time_text(r.window.end));
+}
+
+/// The first lock, then the first reservation of another agent than `agent`, that `blocks`
+/// on `entity` or a member of its conflict set, described; nullopt if there is none.
+template <class Blocks>
+std::optional<std::string> first_blocker_text(const topology::Topology& topology,
+                                              const TimelineSet& timelines, EntityIndex entity,
+                                              std::string_view agent, Blocks blocks) {
+  std::vector<EntityIndex> places{entity};
+  places.insert(places.end(), topology.conflicts(entity).begin(),
+                topology.conflicts(entity).end());
+  for (const EntityIndex place : places) {
+    if (!timelines.owns(place)) continue;
+    const topology::Timeline& timeline = timelines.timeline(place);
+    for (const topology::Lock& lock : timeline.locks) {
+      if (blocks(lock.window)) return lock_text(topology, place, lock);
+    }
+    for (const topology::Reservation& r : timeline.reservations) {
+      if (r.agent != agent && blocks(r.window)) return reservation_text(topology, place, r);
+    }
+  }
+  return std::nullopt;
+}
+
 /// What keeps `agent` off `entity` at time t: a lock or another agent's reservation on the
 /// entity or its conflict set (the blockers of TimelineSet::free_windows).
 std::string blocker_text(const topology::Topology& topology, const TimelineSet& timelines,
                          EntityIndex entity, std::string_view agent, TimeNs t) {
-  std::vector<EntityIndex> places{entity};
-  places.insert(places.end(), topology.conflicts(entity).begin(),
-                topology.conflicts(entity).end());
-  for (const EntityIndex place : places) {
-    if (!timelines.owns(place)) continue;
-    const topology::Timeline& timeline = timelines.timeline(place);
-    for (const topology::Lock& lock : timeline.locks) {
-      if (lock.window.contains(t)) {
-        return fmt::format("lock {} on '{}' [{}, {}) by {}: {}", lock.id, topology.id(place),
-                           time_text(lock.window.start), time_text(lock.window.end),
-                           lock.operator_id, lock.reason);
-      }
-    }
-    for (const topology::Reservation& r : timeline.reservations) {
-      if (r.agent != agent && r.window.contains(t)) {
-        return fmt::format("agent {} route {} holds '{}'{} [{}, {})", r.agent, r.route,
-                           topology.id(r.origin),
-                           r.shadow() ? fmt::format(" (conflicting with '{}')", topology.id(place))
-                                      : std::string(),
-                           time_text(r.window.start), time_text(r.window.end));
-      }
-    }
-  }
-  return "another agent's allocation there (nobody may come before a holder)";
+  return first_blocker_text(topology, timelines, entity, agent,
+                            [t](const Interval& window) { return window.contains(t); })
+      .value_or("another agent's allocation there (nobody may come before a holder)");
 }
 
 /// What holds `entity` (or a member of its conflict set) open-ended against `agent`: the
-/// reason it is never free for good.
+/// reason it is never free for good, named as the open-ended lock or reservation itself
+/// (not whatever else overlaps its start). Falls back to what blocks at `from`.
 std::string forever_blocker_text(const topology::Topology& topology, const TimelineSet& timelines,
                                  EntityIndex entity, std::string_view agent, TimeNs from) {
-  std::vector<EntityIndex> places{entity};
-  places.insert(places.end(), topology.conflicts(entity).begin(),
-                topology.conflicts(entity).end());
-  for (const EntityIndex place : places) {
-    if (!timelines.owns(place)) continue;
-    const topology::Timeline& timeline = timelines.timeline(place);
-    for (const topology::Lock& lock : timeline.locks) {
-      if (lock.window.end == kForever) {
-        return blocker_text(topology, timelines, place, agent, lock.window.start);
-      }
-    }
-    for (const topology::Reservation& r : timeline.reservations) {
-      if (r.agent != agent && r.window.end == kForever) {
-        return blocker_text(topology, timelines, place, agent, r.window.start);
-      }
-    }
-  }
-  return blocker_text(topology, timelines, entity, agent, from);
+  const auto open_ended = first_blocker_text(
+      topology, timelines, entity, agent, [](const Interval& window) { return window.end == kForever; });
+  return open_ended ? *open_ended : blocker_text(topology, timelines, entity, agent, from);
 }
 
 /// Adds to `holders` the agents other than `agent` that hold `entity` open-ended, on the

@@ -332,6 +332,18 @@ TEST(Planner, ABlockedStartIsReportedOnlyAfterTheChecksThatComeFirst) {
   EXPECT_NE(goal.message.find("never free for good"), std::string::npos) << goal.message;
 }
 
+// The explanation names what holds the goal for good, not whatever else overlaps its start
+// there (here the edge its holder arrives by, whose shadow the goal's timeline carries).
+TEST(Planner, AGoalHeldForGoodIsExplainedByItsOpenEndedHold) {
+  World w(GridBuilder().corridor(4).build());
+  w.occupy("b", "2,0-3,0", sec(5), sec(8));
+  w.occupy("b", "3,0", sec(7), kForever);
+  const PlanError e = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "3,0")}));
+  EXPECT_EQ(e.reason, PlanFailure::no_window);
+  EXPECT_NE(e.message.find("agent b route 1001 holds '3,0' [7.000 s, forever)"), std::string::npos)
+      << e.message;
+}
+
 TEST(Planner, GivesUpAtTheHorizon) {
   World w(GridBuilder().corridor(5).build(), PlannerOptions{.horizon = sec(10)});
   w.occupy("b", "2,0", sec(0), sec(100));
