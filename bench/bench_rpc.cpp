@@ -45,6 +45,7 @@
 #include "drover/dds/service_client.hpp"
 #include "drover/dds/service_server.hpp"
 #include "drover/dds/shutdown_signal.hpp"
+#include "drover/topology/topology_file.hpp"
 
 extern char** environ;
 
@@ -318,8 +319,32 @@ std::variant<RouteTarget, int> start_route_target(const RpcArguments& arguments,
   return target;
 }
 
+/// Route mode's input, checked before any process starts: the topology loads and holds both
+/// ends of the test route. \return kExitOk, or kExitBadInput with the problems printed.
+int check_route_input(const RpcArguments& arguments) {
+  const auto loaded = topology::load_topology_file(arguments.topology_file);
+  if (!loaded) {
+    for (const auto& problem : loaded.error()) {
+      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
+    }
+    return cli::kExitBadInput;
+  }
+  for (const std::string& end : {arguments.route_from, arguments.route_to}) {
+    const auto found = loaded->find(end);
+    if (!found || !loaded->is_vertex(*found)) {
+      std::cerr << "error: " << arguments.topology_file << ": no vertex '" << end
+                << "' (--from and --to name vertices of the topology)\n";
+      return cli::kExitBadInput;
+    }
+  }
+  return cli::kExitOk;
+}
+
 /// The measured run; \return the exit code.
 int run_benchmark(const RpcArguments& arguments) {
+  if (arguments.route) {
+    if (const int checked = check_route_input(arguments); checked != cli::kExitOk) return checked;
+  }
   auto server_process = ServerProcess::start({"bench", "rpc-server", "--domain", std::to_string(arguments.domain_id)});
   if (!server_process) {
     std::cerr << "error: cannot start the rpc-server process\n";

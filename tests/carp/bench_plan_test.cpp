@@ -71,9 +71,15 @@ class BenchPlan : public ::testing::Test {
   /// default, read back into the result).
   CommandRun bench_plan(const std::vector<std::string>& arguments,
                         const std::string& out_file = "") {
+    return bench("plan", arguments, out_file);
+  }
+
+  /// Runs `drover bench WHICH ARGUMENTS...`, as bench_plan does.
+  CommandRun bench(const std::string& which, const std::vector<std::string>& arguments,
+                   const std::string& out_file = "") {
     const char* binary_dir = std::getenv("DROVER_BINARY_DIR");
     const fs::path binary = fs::path(binary_dir ? binary_dir : "build") / "bin" / "drover";
-    std::string command = quoted(binary.string()) + " bench plan";
+    std::string command = quoted(binary.string()) + " bench " + quoted(which);
     for (const auto& argument : arguments) command += " " + quoted(argument);
     const std::string out = out_file.empty() ? path("stdout") : out_file;
     command += " >" + quoted(out) + " 2>" + quoted(path("stderr"));
@@ -229,6 +235,24 @@ TEST_F(BenchPlan, AnUnwritableStandardOutputFailsTheRun) {
       {"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "1"}, "/dev/full");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("cannot write to standard output"), std::string::npos) << run.err;
+}
+
+// bench rpc --route checks its topology and route ends before it starts any process: bad
+// input is exit 2 at once, not an agent's error and a failed route after seconds of waiting.
+TEST_F(BenchPlan, BenchRpcRouteRefusesABadTopologyBeforeStartingAgents) {
+  write("bad.json", "{\"name\": \"t\", \"vertices\": [{\"id\": \"a\", \"x\": 1e400, \"y\": 0}],\n"
+                    "\"edges\": []}\n");
+  write("one.json", "{\"name\": \"t\", \"vertices\": [{\"id\": \"a\", \"x\": 0, \"y\": 0}], "
+                    "\"edges\": []}\n");
+  const CommandRun bad = bench("rpc", {"--route", "--topology", path("bad.json"), "--calls", "1"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find(path("bad.json") + ":line 1, column 49: malformed JSON: number overflow"),
+            std::string::npos)
+      << bad.err;
+  const CommandRun missing = bench(
+      "rpc", {"--route", "--topology", path("one.json"), "--from", "a", "--to", "b", "--calls", "1"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find(path("one.json") + ": no vertex 'b'"), std::string::npos) << missing.err;
 }
 
 }  // namespace
