@@ -177,10 +177,12 @@ class WindowSearch {
   LateProof prove_late(const SearchInput& input, ProofKind kind, TimeNs deadline,
                        std::size_t budget);
   /// After prove_late reached the start: the route its labels lead to, from the start state
-  /// ready at the start time, into path_. At each state it drives to the successor closest
-  /// to the goal (then the earliest) whose label it reaches by: a label is the latest the
-  /// vehicle may be ready there and still arrive by the deadline, so one always exists.
-  void follow_labels(const SearchInput& input);
+  /// ready at the start time, into path_: the earliest at every state among the moves that
+  /// reach a state within its label (the latest the vehicle may be ready there and still
+  /// arrive by the deadline, so such moves lead to the last stop), found in Dijkstra's order
+  /// of ready times. Visits each labelled state at most once; never revisits one on the route.
+  /// \return true (false only if the labels were unsound: then path_ is unchanged).
+  bool follow_labels(const SearchInput& input);
   /// True when the last stop is shut in: the vertices from which it can be reached over
   /// arcs whose edge and source vertex some time become free for good (their last window is
   /// open-ended) are at most input.shut_in_region, the start not among them. Every route
@@ -425,6 +427,18 @@ class WindowSearch {
   std::vector<std::uint32_t> region_stamp_;
   std::vector<topology::EntityIndex> region_queue_;
   std::vector<State> path_;  // the route found, from the start state to the goal's
+  // follow_labels' search: the states it reached (parent: an index here), the best of them
+  // per window id (valid where stamped with the proof's late_generation_), and the open ones
+  // by ready time.
+  struct WalkEntry {
+    TimeNs ready;
+    std::uint32_t state;
+    bool operator>(const WalkEntry& o) const { return ready > o.ready; }
+  };
+  std::vector<State> walk_states_;
+  std::vector<std::uint32_t> walk_best_;
+  std::vector<std::uint32_t> walk_stamp_;
+  MinHeap<WalkEntry> walk_open_;
 };
 
 }  // namespace drover::carp

@@ -344,6 +344,28 @@ TEST(Planner, AGoalHeldForGoodIsExplainedByItsOpenEndedHold) {
       << e.message;
 }
 
+// A route a floor proof finds waits where it must, like the search's routes: it does not
+// drive back and forth over a short edge for as long as the wait lasts (it once took 1 803
+// steps here, and with a 1 µm edge it ran until memory was exhausted).
+TEST(Planner, ARouteFromAProofWaitsInsteadOfDrivingBackAndForth) {
+  GridBuilder grid;  // A - S - G: the vehicle starts on S, must make way, and waits on A
+  grid.cell(0, 0).cell(1, 0).cell(2, 0);
+  grid.edge(0, 0, 1, 0, {.length = 0.01});
+  grid.edge(1, 0, 2, 0);
+  World w(grid.build(), PlannerOptions{.floor_proof_after = 1});  // a proof finds the route
+  w.occupy("b", "2,0", sec(0), sec(30));
+  w.occupy("b", "1,0", sec(10), sec(12));
+  const PlanRequest request = request_to(w, "a", "1,0", {open_stop(w, "2,0")});
+  const auto planned = w.planner.plan(w.timelines, request);
+  ASSERT_TRUE(planned.has_value()) << planned.error().message;
+  EXPECT_EQ(w.planner.last_stats().proof_routes, 1u);
+  check_route(w.topology, w.timelines, request, *planned);
+  EXPECT_EQ(planned->arrival, sec(31));
+  // S, S-A, A (waiting), A-S, S (waiting), S-G, G.
+  EXPECT_EQ(planned->steps.size(), 7u);
+  EXPECT_NEAR(planned->distance, 1.02, 1e-9);
+}
+
 TEST(Planner, GivesUpAtTheHorizon) {
   World w(GridBuilder().corridor(5).build(), PlannerOptions{.horizon = sec(10)});
   w.occupy("b", "2,0", sec(0), sec(100));
