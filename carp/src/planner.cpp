@@ -427,11 +427,13 @@ struct Planner::Impl {
     if (auto bad = check_usable(*traversal, request)) return unexpected(std::move(*bad));
     // A blocked start makes the search fail at once, after the heuristic (about 1 000
     // expansions each on the warehouse map). When the legs are known to be reachable,
-    // prepare_legs cannot fail, so the same answer comes without it: the goal check,
-    // then the blocked start, in the order of the checks below.
+    // prepare_legs can fail only as no_window (stops too far apart for the horizon), so the
+    // answer of the checks below comes without it (the goal check, then the blocked start)
+    // unless that answer blames a lock: locks are named only where nothing else blocks.
     if (!start_free(timelines, request) && legs_reachable(*traversal, request)) {
-      if (auto bad = check_goal_held(timelines, request)) return unexpected(std::move(*bad));
-      return unexpected(blocked_start(timelines, request));
+      auto early = check_goal_held(timelines, request);
+      if (!early) early = blocked_start(timelines, request);
+      if (early->reason != PlanFailure::locked) return unexpected(std::move(*early));
     }
     if (auto bad = prepare_legs(*traversal, class_id, request)) {
       return unexpected(std::move(*bad));

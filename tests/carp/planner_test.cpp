@@ -366,6 +366,25 @@ TEST(Planner, ARouteFromAProofWaitsInsteadOfDrivingBackAndForth) {
   EXPECT_NEAR(planned->distance, 1.02, 1e-9);
 }
 
+// `locked` means the locks alone stand in the way: with a horizon shorter than the trip no
+// route exists without them either, whatever the shape of the graph.
+TEST(Planner, ALockIsNotBlamedWhereTheHorizonAloneRulesOutEveryRoute) {
+  for (const bool two_way : {true, false}) {
+    SCOPED_TRACE(two_way ? "two-way corridor" : "one-way last edge");
+    GridBuilder grid;
+    grid.cell(0, 0).cell(1, 0).cell(2, 0);
+    grid.edge(0, 0, 1, 0);
+    grid.edge(1, 0, 2, 0, {.bidirectional = two_way});
+    World w(grid.build(), PlannerOptions{.horizon = sec(1)});  // the trip takes 2 s
+    ASSERT_TRUE(w.timelines.lock(w.at("0,0"), {sec(0), sec(5)}, "op", "inspection"));
+    EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")})).reason,
+              PlanFailure::no_window);
+    ASSERT_TRUE(w.timelines.lock(w.at("2,0"), {sec(0), kForever}, "op", "closed"));
+    EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")})).reason,
+              PlanFailure::no_window);
+  }
+}
+
 TEST(Planner, GivesUpAtTheHorizon) {
   World w(GridBuilder().corridor(5).build(), PlannerOptions{.horizon = sec(10)});
   w.occupy("b", "2,0", sec(0), sec(100));
