@@ -107,7 +107,10 @@ Result<std::vector<ScenarioTask>> parse_scenario(std::string_view text, const st
     }
     tasks.push_back(std::move(task));
   }
-  if (!header_seen) return bad(std::max(line_number, 1), "empty file (expected \"version 1\")");
+  if (!header_seen) {
+    return bad(std::max(line_number, 1), std::string(text.empty() ? "empty file" : "only blank lines") +
+                                             " (expected \"version 1\")");
+  }
   return tasks;
 }
 

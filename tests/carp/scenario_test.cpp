@@ -38,6 +38,7 @@ TEST(Scenario, ReportsTheLineAndWhatIsWrong) {
     const char* message;
   } cases[] = {
       {"", "s.scen:line 1: empty file"},
+      {"\n  \r\n\t\n", "s.scen:line 3: only blank lines (expected \"version 1\")"},
       {"version 2\n", "s.scen:line 1: unsupported version '2'"},
       {"3\tm.map\t8\t8\t0\t0\t1\t1\t2\n", "s.scen:line 1: expected \"version 1\""},
       {"version 1\n0\tm.map\t8\t8\t0\t0\t1\t1\n", "s.scen:line 2: expected 9 fields"},
