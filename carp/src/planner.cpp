@@ -390,20 +390,33 @@ struct Planner::Impl {
                              vertex_name(request.start), time_text(request.start_time), why));
   }
 
-  /// Explains a search that found nothing (only called then, so it may take its time).
-  PlanError diagnose(const TimelineSet& timelines, const PlanRequest& request,
-                     SearchInput input, const SearchOutcome& outcome) {
-    if (!outcome.start_free) return blocked_start(timelines, request);
+  /// Explains a search that found nothing (only called then, so it may take its time), or
+  /// that was not run because `lock_blame` (a lock on the start or the last stop) rules
+  /// every route out. A lock is blamed only where a search without locks finds a route:
+  /// otherwise the reservations are, as that search saw them.
+  PlanError diagnose(const TimelineSet& timelines, const PlanRequest& request, SearchInput input,
+                     const SearchOutcome& outcome, std::optional<PlanError> lock_blame = {}) {
     const EntityIndex goal = request.stops.back().vertex;
-    input.count_locks = false;
+    SearchOutcome explained = outcome;
     // Without any lock, a search without locks would find nothing new.
-    if (timelines.lock_count() > 0 && search.run(input).found) {
-      return error(PlanFailure::locked,
-                   fmt::format("locks block every route to {}; without them it would arrive "
-                               "at {}",
-                               vertex_name(goal), time_text(search.route(input).arrival)));
+    if (timelines.lock_count() > 0) {
+      if (!lock_blame && !outcome.start_free) {
+        PlanError blocked = blocked_start(timelines, request);
+        if (blocked.reason != PlanFailure::locked) return blocked;
+        lock_blame = std::move(blocked);
+      }
+      input.count_locks = false;
+      explained = search.run(input);
+      if (explained.found) {
+        if (lock_blame) return std::move(*lock_blame);
+        return error(PlanFailure::locked,
+                     fmt::format("locks block every route to {}; without them it would arrive "
+                                 "at {}",
+                                 vertex_name(goal), time_text(search.route(input).arrival)));
+      }
     }
-    if (outcome.horizon_cut) {
+    if (!explained.start_free) return blocked_start(timelines, request);
+    if (explained.horizon_cut) {
       return error(PlanFailure::no_window,
                    fmt::format("no sequence of free windows reaches {} within the horizon of "
                                "{} after {}",
@@ -429,7 +442,8 @@ struct Planner::Impl {
     // expansions each on the warehouse map). When the legs are known to be reachable,
     // prepare_legs can fail only as no_window (stops too far apart for the horizon), so the
     // answer of the checks below comes without it (the goal check, then the blocked start)
-    // unless that answer blames a lock: locks are named only where nothing else blocks.
+    // unless that answer blames a lock: a lock is blamed only where a search without locks
+    // finds a route (diagnose), which needs the legs.
     if (!start_free(timelines, request) && legs_reachable(*traversal, request)) {
       auto early = check_goal_held(timelines, request);
       if (!early) early = blocked_start(timelines, request);
@@ -438,7 +452,10 @@ struct Planner::Impl {
     if (auto bad = prepare_legs(*traversal, class_id, request)) {
       return unexpected(std::move(*bad));
     }
-    if (auto bad = check_goal_held(timelines, request)) return unexpected(std::move(*bad));
+    auto goal_held = check_goal_held(timelines, request);
+    if (goal_held && goal_held->reason != PlanFailure::locked) {
+      return unexpected(std::move(*goal_held));
+    }
     SearchInput input;
     input.graph = graph.get();
     input.traversal = traversal;
@@ -455,6 +472,9 @@ struct Planner::Impl {
     input.shut_in_after = options.shut_in_after;
     input.shut_in_region = options.shut_in_region;
     input.shut_in_budget = options.shut_in_budget;
+    if (goal_held) {  // locked for good: confirmed, or not, by a search without locks
+      return unexpected(diagnose(timelines, request, input, SearchOutcome{}, std::move(goal_held)));
+    }
     const SearchOutcome outcome = search.run(input);
     stats = search.stats();
     if (!outcome.found) return unexpected(diagnose(timelines, request, input, outcome));

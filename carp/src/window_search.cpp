@@ -255,6 +255,7 @@ WindowSearch::LateProof WindowSearch::prove_late(const SearchInput& input, Proof
   const Traversal::Adjacency& adjacency = input.traversal->adjacency(*input.graph);
   if (++late_generation_ == 0) {  // wrapped: every stamp could look current
     std::fill(late_stamp_.begin(), late_stamp_.end(), 0);
+    std::fill(walk_stamp_.begin(), walk_stamp_.end(), 0);  // follow_labels stamps with it too
     late_generation_ = 1;
   }
   late_open_.clear();

@@ -326,10 +326,17 @@ TEST(Planner, ABlockedStartIsReportedOnlyAfterTheChecksThatComeFirst) {
   const PlanError blocked = plan_error(c, request_to(c, "a", "0,0", {open_stop(c, "3,0")}));
   EXPECT_EQ(blocked.reason, PlanFailure::no_window);
   EXPECT_TRUE(start_message(blocked)) << blocked.message;
-  ASSERT_TRUE(c.timelines.lock(c.at("3,0"), {sec(20), kForever}, "op", "closed"));
+  c.occupy("c", "3,0", sec(20), kForever);
   const PlanError goal = plan_error(c, request_to(c, "a", "0,0", {open_stop(c, "3,0")}));
-  EXPECT_EQ(goal.reason, PlanFailure::locked);
+  EXPECT_EQ(goal.reason, PlanFailure::no_window);
   EXPECT_NE(goal.message.find("never free for good"), std::string::npos) << goal.message;
+  // A goal locked for good is not what stands in the way while the start is taken.
+  World l(GridBuilder().corridor(4).build());
+  l.occupy("b", "0,0", sec(0), sec(10));
+  ASSERT_TRUE(l.timelines.lock(l.at("3,0"), {sec(20), kForever}, "op", "closed"));
+  const PlanError locked_goal = plan_error(l, request_to(l, "a", "0,0", {open_stop(l, "3,0")}));
+  EXPECT_EQ(locked_goal.reason, PlanFailure::no_window);
+  EXPECT_TRUE(start_message(locked_goal)) << locked_goal.message;
 }
 
 // The explanation names what holds the goal for good, not whatever else overlaps its start
@@ -383,6 +390,30 @@ TEST(Planner, ALockIsNotBlamedWhereTheHorizonAloneRulesOutEveryRoute) {
     EXPECT_EQ(plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")})).reason,
               PlanFailure::no_window);
   }
+}
+
+// Nor where the reservations alone rule out every route: the lock is not what stands in the way.
+TEST(Planner, ALockIsNotBlamedWhereReservationsAloneRuleOutEveryRoute) {
+  World w(GridBuilder().corridor(3).build());
+  ASSERT_TRUE(w.timelines.lock(w.at("0,0"), {sec(0), sec(5)}, "op", "inspection"));
+  w.occupy("b", "1,0", sec(0), kForever);  // parked in the only way for good
+  const PlanError start = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+  EXPECT_EQ(start.reason, PlanFailure::no_window) << start.message;
+  ASSERT_TRUE(w.timelines.lock(w.at("2,0"), {sec(0), kForever}, "op", "closed"));
+  const PlanError goal = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}));
+  EXPECT_EQ(goal.reason, PlanFailure::no_window) << goal.message;
+  // Where the lock alone blocks, it is named.
+  World free(GridBuilder().corridor(3).build());
+  ASSERT_TRUE(free.timelines.lock(free.at("0,0"), {sec(0), sec(5)}, "op", "inspection"));
+  const PlanError locked = plan_error(free, request_to(free, "a", "0,0", {open_stop(free, "2,0")}));
+  EXPECT_EQ(locked.reason, PlanFailure::locked);
+  EXPECT_NE(locked.message.find("start vertex '0,0' is not free at 0.000 s: lock"), std::string::npos)
+      << locked.message;
+  ASSERT_TRUE(free.timelines.lock(free.at("2,0"), {sec(0), kForever}, "op", "closed"));
+  const PlanError closed = plan_error(free, request_to(free, "a", "1,0", {open_stop(free, "2,0")}));
+  EXPECT_EQ(closed.reason, PlanFailure::locked);
+  EXPECT_NE(closed.message.find("the last stop '2,0' is never free for good"), std::string::npos)
+      << closed.message;
 }
 
 TEST(Planner, GivesUpAtTheHorizon) {
