@@ -43,8 +43,10 @@ Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
     return fail(ErrorCode::invalid_argument, fmt::format("{}: is a directory", path.string()));
   }
   // A link at the temporary name is replaced, not written through to the file it names.
-  if (std::filesystem::is_symlink(std::filesystem::symlink_status(partial, error))) {
-    std::filesystem::remove(partial, error);
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(partial, error)) &&
+      !std::filesystem::remove(partial, error)) {
+    return fail(ErrorCode::io, fmt::format("{}: cannot replace the link {}: {}", path.string(),
+                                           partial.string(), error.message()));
   }
   errno = 0;
   OutputFile file(path, partial);

@@ -16,7 +16,10 @@ namespace {
 /// `text` as a decimal number (an optional sign, digits, a fraction, an exponent), or
 /// nullopt: no hexadecimal, octal or binary prefixes, no "inf" or "nan", nothing after it.
 std::optional<double> decimal(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  if (!text.empty() && text.front() == '+') {
+    text.remove_prefix(1);
+    if (!text.empty() && text.front() == '-') return std::nullopt;  // "+-1"
+  }
   if (text.empty() || !(std::isdigit(static_cast<unsigned char>(text.back())) || text.back() == '.')) {
     return std::nullopt;  // rejects "inf", "nan" and a trailing "e"
   }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drover/common/json_syntax.hpp"
+#include "drover/common/text_file.hpp"
 
 namespace drover::carp {
 
@@ -48,11 +49,9 @@ Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std:
 }
 
 Result<VehicleProfile> read_vehicle_profile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return fail(ErrorCode::io, path + ": cannot read the vehicle profile");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_vehicle_profile(text.str(), path);
+  auto text = read_text_file(path);
+  if (!text) return fail(ErrorCode::io, path + ": " + text.error().message);
+  return parse_vehicle_profile(*text, path);
 }
 
 }  // namespace drover::carp

@@ -37,14 +37,14 @@ std::optional<std::size_t> failure_offset(std::string_view text) {
 }
 
 /// "line L, column C" as nlohmann counts them: lines from 1, the column of the last
-/// character read (0 right after a line break).
+/// character read (0 right after a line break). At the end of the text the offset is one
+/// past it: the end counts as a character read.
 std::string line_and_column(std::string_view text, std::size_t offset) {
   const std::string_view read = text.substr(0, std::min(offset, text.size()));
   const std::size_t last_break = read.rfind('\n');
-  const std::size_t column = last_break == std::string_view::npos ? read.size()
-                                                                   : read.size() - last_break - 1;
+  const std::size_t line_start = last_break == std::string_view::npos ? 0 : last_break + 1;
   return "line " + std::to_string(std::count(read.begin(), read.end(), '\n') + 1) + ", column " +
-         std::to_string(column);
+         std::to_string(offset - line_start);
 }
 
 /// nlohmann's message without "[json.exception.KIND.N] " and "parse error at ...: ".

@@ -10,6 +10,9 @@
 namespace drover {
 
 Result<std::string> read_text_file(const std::filesystem::path& path) {
+  const auto too_large = [] {
+    return fail(ErrorCode::io, "larger than " + std::to_string(kMaxTextFileBytes >> 20) + " MiB");
+  };
   std::error_code error;
   const auto type = std::filesystem::status(path, error).type();
   if (type == std::filesystem::file_type::directory) return fail(ErrorCode::io, "is a directory");
@@ -18,6 +21,11 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
   if (type == std::filesystem::file_type::character || type == std::filesystem::file_type::block ||
       type == std::filesystem::file_type::socket) {
     return fail(ErrorCode::io, "is a device or socket, not a file");
+  }
+  // A regular file too large is refused before reading it; a pipe, as it grows past the bound.
+  if (type == std::filesystem::file_type::regular &&
+      std::filesystem::file_size(path, error) > kMaxTextFileBytes && !error) {
+    return too_large();
   }
   errno = 0;
   std::ifstream in(path, std::ios::binary);
@@ -28,9 +36,7 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
   std::string text;
   char chunk[1 << 16];
   while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-    if (text.size() + static_cast<std::size_t>(in.gcount()) > kMaxTextFileBytes) {
-      return fail(ErrorCode::io, "larger than " + std::to_string(kMaxTextFileBytes >> 20) + " MiB");
-    }
+    if (text.size() + static_cast<std::size_t>(in.gcount()) > kMaxTextFileBytes) return too_large();
     text.append(chunk, static_cast<std::size_t>(in.gcount()));
   }
   if (in.bad()) return fail(ErrorCode::io, "cannot read: I/O error");

@@ -41,7 +41,7 @@ TEST(NumberChecks, WholeNumbersAreReadAsDecimalsWhateverTheirLeadingZeros) {
 
 TEST(NumberChecks, OtherNotationsAreNotNumbers) {
   std::size_t count = 0;
-  for (const char* text : {"0x0A", "0b11", "abc", "inf", "nan", "1e", " 3", "", "1,5"}) {
+  for (const char* text : {"0x0A", "0b11", "abc", "inf", "nan", "1e", " 3", "", "1,5", "+-0", "++1"}) {
     SCOPED_TRACE(text);
     EXPECT_NE(parse(text, whole_in(1, 100), count).find("is not a number"), std::string::npos);
     double seconds = 0;

@@ -201,7 +201,7 @@ TEST_F(BenchPlan, RefusesBadInputWithExitCode2) {
       {{"--map", "", "--scen", path("ring.scen"), "--agents", "1"}, "--map: must not be empty"},
       {{"--map", path("ring.map"), "--scen", "", "--agents", "1"}, "--scen: must not be empty"},
       {{"--map", path("ring.map"), "--scen", path("ring.scen"), "--agents", "010"},
-       "but the scenario has only 3 tasks"},  // ten, not octal eight
+       "--agents 10 but the scenario has only 3 tasks"},  // ten, not octal eight
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.message);

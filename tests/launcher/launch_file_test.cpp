@@ -192,7 +192,11 @@ TEST(LaunchFile, EveryPartitionNeedsATopologyAgent) {
 TEST(LaunchFile, UnreadableFile) {
   auto loaded = load_launch_file("/nonexistent/launch.json", "/state");
   ASSERT_FALSE(loaded.has_value());
-  EXPECT_EQ(loaded.error().front().what, "cannot read the file");
+  EXPECT_EQ(loaded.error().front().what, "cannot open: No such file or directory");
+  // A device is refused, not read until memory runs out.
+  auto device = load_launch_file("/dev/zero", "/state");
+  ASSERT_FALSE(device.has_value());
+  EXPECT_EQ(device.error().front().what, "is a device or socket, not a file");
 }
 
 TEST(LaunchFile, BundledWarehouseIsValid) {

@@ -281,6 +281,8 @@ TEST(VehicleProfileJson, ParsesAndNamesBadFields) {
   EXPECT_EQ(huge.error().message,
             "v.json:line 1, column 19: malformed JSON: number overflow parsing '1e400'");
   EXPECT_EQ(carp::read_vehicle_profile("/nonexistent/v.json").error().code, ErrorCode::io);
+  EXPECT_EQ(carp::read_vehicle_profile("/dev/zero").error().message,
+            "/dev/zero: is a device or socket, not a file");
 }
 
 }  // namespace

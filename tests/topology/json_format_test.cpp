@@ -254,6 +254,13 @@ TEST(JsonFormat, TopLevelAndOptionProblemsAreReported) {
   ASSERT_EQ(huge.size(), 1u);
   EXPECT_EQ(huge[0].where, "line 2, column 28") << "at the number's last character";
   EXPECT_EQ(huge[0].what, "malformed JSON: number overflow parsing '1e999'");
+  // At the end of the text, the end counts as a character read, as nlohmann counts it.
+  const auto cut = errors_of(parse_topology_json("{\"name\": \"t\",\n"));
+  ASSERT_EQ(cut.size(), 1u);
+  EXPECT_EQ(cut[0].where, "line 2, column 1");
+  const auto cut_in_line = errors_of(parse_topology_json("{\"vertices\": ["));
+  ASSERT_EQ(cut_in_line.size(), 1u);
+  EXPECT_EQ(cut_in_line[0].where, "line 1, column 15");
 }
 
 TEST(JsonFormat, KeysGivenTwiceAreReportedWithTheirPath) {

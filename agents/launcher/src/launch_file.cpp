@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drover/common/json_syntax.hpp"
+#include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/topology/topology_file.hpp"
 
@@ -575,11 +576,9 @@ Result<LaunchFile, LaunchProblems> parse_launch_file(std::string_view text,
 
 Result<LaunchFile, LaunchProblems> load_launch_file(const std::filesystem::path& path,
                                                     const std::filesystem::path& state_dir) {
-  std::ifstream in(path);
-  if (!in) return unexpected(LaunchProblems{{"", "cannot read the file"}});
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_launch_file(text.str(), path, state_dir);
+  auto text = read_text_file(path);
+  if (!text) return unexpected(LaunchProblems{{"", std::move(text).error().message}});
+  return parse_launch_file(*text, path, state_dir);
 }
 
 }  // namespace drover::launcher
