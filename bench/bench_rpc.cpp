@@ -467,13 +467,13 @@ void add_bench_rpc_command(CLI::App& bench, cli::CommandContext& context) {
   auto arguments = std::make_shared<RpcArguments>();
   auto* rpc = bench.add_subcommand(
       "rpc", "Request/reply round trips over the DDS service layer vs a raw DDS ping-pong");
-  rpc->add_option("--domain", arguments->domain_id, "DDS domain id (default 99)")->check(CLI::Range(0, 232));
+  rpc->add_option("--domain", arguments->domain_id, "DDS domain id (default 99)")->transform(cli::whole_in(0, 232));
   rpc->add_option("--calls", arguments->calls, "Measured round trips of each kind (default 2000)")
-      ->check(CLI::Range(1, 10'000'000));
+      ->transform(cli::whole_in(1, 10'000'000));
   rpc->add_option("--warmup", arguments->warmup, "Unmeasured round trips first (default 200)")
-      ->check(CLI::Range(0, 1'000'000));
+      ->transform(cli::whole_in(0, 1'000'000));
   rpc->add_option("--payload", arguments->payload_bytes, "Payload bytes per request (default 512)")
-      ->check(CLI::Range(0, 1'000'000));
+      ->transform(cli::whole_in(0, 1'000'000));
   rpc->add_flag("--route", arguments->route,
                 "Measure the routing agent's route service (test routes) instead of the ping echo; starts a "
                 "topology agent and a routing agent");
@@ -487,7 +487,7 @@ void add_bench_rpc_command(CLI::App& bench, cli::CommandContext& context) {
   // The partner process; started by `rpc` itself, so hidden from the help.
   auto* server = bench.add_subcommand("rpc-server", "Partner process of `drover bench rpc`");
   server->group("");
-  server->add_option("--domain", arguments->domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  server->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   server->callback([arguments, &context] { context.exit_code = run_server(*arguments); });
 }
 

@@ -13,22 +13,6 @@ namespace drover::cli {
 
 namespace {
 
-/// `text` as a decimal number (an optional sign, digits, a fraction, an exponent), or
-/// nullopt: no hexadecimal, octal or binary prefixes, no "inf" or "nan", nothing after it.
-std::optional<double> decimal(std::string_view text) {
-  if (!text.empty() && text.front() == '+') {
-    text.remove_prefix(1);
-    if (!text.empty() && text.front() == '-') return std::nullopt;  // "+-1"
-  }
-  if (text.empty() || !(std::isdigit(static_cast<unsigned char>(text.back())) || text.back() == '.')) {
-    return std::nullopt;  // rejects "inf", "nan" and a trailing "e"
-  }
-  double value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-  return value;
-}
-
 /// The text CLI11 reads back as exactly `value`: an integer without a fraction where the
 /// value is whole and exact as a double, the shortest round trip otherwise.
 std::string plain(double value) {
@@ -44,10 +28,11 @@ enum class Sign { positive, non_negative };
 CLI::Validator sign_check(Sign sign) {
   return CLI::Validator(
       [sign](std::string& input) -> std::string {
-        const auto value = decimal(input);
+        const auto value = parse_decimal(input);
         if (!value) return "'" + input + "' is not a number";
         const bool fine = sign == Sign::positive ? *value > 0 : *value >= 0;
         if (!fine) return std::string(sign == Sign::positive ? "must be > 0" : "must be >= 0") + ", got " + input;
+        if (*value > kLargestOptionValue) return "must be at most " + plain(kLargestOptionValue) + ", got " + input;
         input = plain(*value);
         return {};
       },
@@ -57,7 +42,7 @@ CLI::Validator sign_check(Sign sign) {
 CLI::Validator range_check(double low, double high, bool whole) {
   return CLI::Validator(
       [=](std::string& input) -> std::string {
-        const auto value = decimal(input);
+        const auto value = parse_decimal(input);
         if (!value) return "'" + input + "' is not a number";
         if (whole && *value != std::floor(*value)) return "must be a whole number, got " + input;
         if (!(*value >= low && *value <= high)) {
@@ -70,6 +55,20 @@ CLI::Validator range_check(double low, double high, bool whole) {
 }
 
 }  // namespace
+
+std::optional<double> parse_decimal(std::string_view text) {
+  if (!text.empty() && text.front() == '+') {
+    text.remove_prefix(1);
+    if (!text.empty() && text.front() == '-') return std::nullopt;  // "+-1"
+  }
+  if (text.empty() || !(std::isdigit(static_cast<unsigned char>(text.back())) || text.back() == '.')) {
+    return std::nullopt;  // rejects "inf", "nan" and a trailing "e"
+  }
+  double value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return value;
+}
 
 CLI::Validator positive() { return sign_check(Sign::positive); }
 

@@ -71,6 +71,19 @@ TEST(NumberChecks, RangesAndSignsAreNamedWithTheValueAsGiven) {
   EXPECT_DOUBLE_EQ(seconds, 0.001);
   EXPECT_EQ(parse("-0", non_negative(), seconds), "");
   EXPECT_EQ(seconds, 0.0);
+  // Seconds beyond any use would overflow as nanoseconds.
+  EXPECT_NE(parse("1e300", positive(), seconds).find("must be at most 1000000000, got 1e300"),
+            std::string::npos);
+  EXPECT_EQ(parse("1e9", non_negative(), seconds), "");
+}
+
+TEST(NumberChecks, DecimalsInsideOptionValuesAreReadTheSameWay) {
+  EXPECT_EQ(parse_decimal("2.5"), 2.5);
+  EXPECT_EQ(parse_decimal("+3"), 3.0);
+  EXPECT_EQ(parse_decimal("010"), 10.0);
+  for (const char* text : {"0x5", " 1", "1 ", "inf", "", "+-1", "5s"}) {
+    EXPECT_FALSE(parse_decimal(text).has_value()) << text;
+  }
 }
 
 }  // namespace

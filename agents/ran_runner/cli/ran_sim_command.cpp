@@ -79,18 +79,11 @@ int run(RanSimArguments arguments) {
   config.initial_load = arguments.loaded ? ran::LoadState::loaded : ran::LoadState::empty;
   for (const auto& entry : arguments.custom_actions) {
     const auto equals = entry.find('=');
-    double seconds = -1;
-    if (equals != std::string::npos) {
-      try {
-        std::size_t used = 0;
-        seconds = std::stod(entry.substr(equals + 1), &used);
-        if (used != entry.size() - equals - 1) seconds = -1;
-      } catch (const std::exception&) {
-        seconds = -1;
-      }
-    }
-    if (equals == std::string::npos || equals == 0 || !std::isfinite(seconds) || seconds < 0) {
-      return fail_input("--custom-action '" + entry + "': expected NAME=SECONDS, SECONDS >= 0");
+    const double seconds = equals == std::string::npos
+                               ? -1
+                               : cli::parse_decimal(std::string_view(entry).substr(equals + 1)).value_or(-1);
+    if (equals == 0 || seconds < 0 || seconds > cli::kLargestOptionValue) {
+      return fail_input("--custom-action '" + entry + "': expected NAME=SECONDS, SECONDS from 0 to 1e9");
     }
     config.custom_actions[entry.substr(0, equals)] = seconds_to_ns(seconds);
   }
@@ -146,7 +139,8 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
       ->check(CLI::ExistingFile);
   sim->add_option("--at", arguments->at_vertex, "The vertex the vehicle starts at")->required();
   sim->add_option("--heading", arguments->heading,
-                  "Start heading in radians (default: the vertex orientation, else 0)");
+                  "Start heading in radians (default: the vertex orientation, else 0)")
+      ->transform(cli::number_in(-1000, 1000));
   sim->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)");
   sim->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
@@ -157,14 +151,14 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
       ->transform(cli::whole_in(1, 60000));
   sim->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   auto& vehicle = arguments->vehicle;
-  sim->add_option("--max-speed", vehicle.max_speed, "m/s (default 1)");
-  sim->add_option("--acceleration", vehicle.acceleration, "m/s^2 (default 0.5)");
-  sim->add_option("--deceleration", vehicle.deceleration, "m/s^2 (default 0.5)");
-  sim->add_option("--angular-speed", vehicle.angular_speed, "rad/s turning on the spot (default 1)");
-  sim->add_option("--battery-capacity", vehicle.battery_capacity_wh, "Wh (default 1000)");
-  sim->add_option("--battery", vehicle.battery_initial_wh, "Wh at start (default 1000)");
-  sim->add_option("--drain", vehicle.drain_wh_per_metre, "Wh per metre driven (default 0.5)");
-  sim->add_option("--charge-rate", vehicle.charge_wh_per_second, "Wh per second charging (default 1)");
+  sim->add_option("--max-speed", vehicle.max_speed, "m/s (default 1)")->transform(cli::positive());
+  sim->add_option("--acceleration", vehicle.acceleration, "m/s^2 (default 0.5)")->transform(cli::positive());
+  sim->add_option("--deceleration", vehicle.deceleration, "m/s^2 (default 0.5)")->transform(cli::positive());
+  sim->add_option("--angular-speed", vehicle.angular_speed, "rad/s turning on the spot (default 1)")->transform(cli::positive());
+  sim->add_option("--battery-capacity", vehicle.battery_capacity_wh, "Wh (default 1000)")->transform(cli::positive());
+  sim->add_option("--battery", vehicle.battery_initial_wh, "Wh at start (default 1000)")->transform(cli::non_negative());
+  sim->add_option("--drain", vehicle.drain_wh_per_metre, "Wh per metre driven (default 0.5)")->transform(cli::non_negative());
+  sim->add_option("--charge-rate", vehicle.charge_wh_per_second, "Wh per second charging (default 1)")->transform(cli::non_negative());
   sim->add_option("--load-duration", arguments->load_seconds, "s (default 5)")
       ->transform(cli::non_negative());
   sim->add_option("--unload-duration", arguments->unload_seconds, "s (default 5)")
