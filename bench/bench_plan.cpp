@@ -168,10 +168,7 @@ int run_plan_bench(const PlanBenchArguments& arguments) {
   topology::MovingAiOptions map_options;  // 1 m cells, 1 m/s edges
   const auto loaded = topology::load_movingai_grid(arguments.map, map_options);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.map, problem) << "\n";
-    }
-    return cli::kExitBadInput;
+    return cli::report_bad_file(arguments.map, loaded.error());
   }
   const auto tasks = load_scenario(arguments.scenario);
   if (!tasks) {

@@ -324,10 +324,7 @@ std::variant<RouteTarget, int> start_route_target(const RpcArguments& arguments,
 int check_route_input(const RpcArguments& arguments) {
   const auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
-    }
-    return cli::kExitBadInput;
+    return cli::report_bad_file(arguments.topology_file, loaded.error());
   }
   for (const std::string& end : {arguments.route_from, arguments.route_to}) {
     const auto found = loaded->find(end);

@@ -2,9 +2,13 @@
 // Every agent and tool is a subcommand of the one `drover` executable. Each subcommand
 // registers itself on the CLI11 app and reports its exit code through CommandContext.
 
+#include <iostream>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include "agents/cli/number_checks.hpp"
+#include "drover/topology/topology_builder.hpp"
 
 namespace drover::cli {
 
@@ -22,6 +26,15 @@ inline CLI::Validator non_empty() {
   return CLI::Validator(
       [](std::string& text) { return text.empty() ? std::string("must not be empty") : std::string(); },
       "");
+}
+
+/// Prints every problem found in `file` as "error: FILE:WHERE: WHAT" on standard error.
+/// \return kExitBadInput, the exit code of a tool whose input file was refused.
+inline int report_bad_file(const std::string& file, const topology::Diagnostics& problems) {
+  for (const auto& problem : problems) {
+    std::cerr << "error: " << topology::diagnostic_text(file, problem) << "\n";
+  }
+  return kExitBadInput;
 }
 
 /// Filled in by the subcommand that ran.

@@ -118,10 +118,7 @@ int run(const LaunchArguments& arguments) {
   }
   auto file = launcher::load_launch_file(arguments.launch_file, state_dir->path());
   if (!file) {
-    for (const auto& problem : file.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.launch_file, problem) << "\n";
-    }
-    return kExitBadInput;
+    return report_bad_file(arguments.launch_file, file.error());
   }
   if (arguments.time_factor) file->time_factor = *arguments.time_factor;
   if (arguments.domain_id) file->domain_id = *arguments.domain_id;

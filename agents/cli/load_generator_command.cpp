@@ -57,10 +57,7 @@ int run(LoadGeneratorArguments arguments) {
   make_agent_logger(arguments.agent_id, arguments.log_level);
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
-    }
-    return kExitBadInput;
+    return report_bad_file(arguments.topology_file, loaded.error());
   }
   auto stations = stations_of(*loaded, arguments.generator.stations, arguments.topology_file);
   if (!stations) {

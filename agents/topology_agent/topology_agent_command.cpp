@@ -36,10 +36,7 @@ int run(const TopologyAgentArguments& arguments) {
   make_agent_logger(agent_id, arguments.log_level);
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
-    }
-    return kExitBadInput;
+    return report_bad_file(arguments.topology_file, loaded.error());
   }
   auto clock = make_clock(arguments.clock);
   if (!clock) {

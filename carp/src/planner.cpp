@@ -46,12 +46,14 @@ std::string reservation_text(const topology::Topology& topology, EntityIndex pla
                      time_text(r.window.start), time_text(r.window.end));
 }
 
-/// The first lock, then the first reservation of another agent than `agent`, that `blocks`
-/// on `entity` or a member of its conflict set, described; nullopt if there is none.
+/// The first lock (where `with_locks`), then the first reservation of another agent than
+/// `agent`, that `blocks` on `entity` or a member of its conflict set, described; nullopt if
+/// there is none.
 template <class Blocks>
 std::optional<std::string> first_blocker_text(const topology::Topology& topology,
                                               const TimelineSet& timelines, EntityIndex entity,
-                                              std::string_view agent, Blocks blocks) {
+                                              std::string_view agent, Blocks blocks,
+                                              bool with_locks = true) {
   std::vector<EntityIndex> places{entity};
   places.insert(places.end(), topology.conflicts(entity).begin(),
                 topology.conflicts(entity).end());
@@ -59,7 +61,7 @@ std::optional<std::string> first_blocker_text(const topology::Topology& topology
     if (!timelines.owns(place)) continue;
     const topology::Timeline& timeline = timelines.timeline(place);
     for (const topology::Lock& lock : timeline.locks) {
-      if (blocks(lock.window)) return lock_text(topology, place, lock);
+      if (with_locks && blocks(lock.window)) return lock_text(topology, place, lock);
     }
     for (const topology::Reservation& r : timeline.reservations) {
       if (r.agent != agent && blocks(r.window)) return reservation_text(topology, place, r);
@@ -79,11 +81,14 @@ std::string blocker_text(const topology::Topology& topology, const TimelineSet& 
 
 /// What holds `entity` (or a member of its conflict set) open-ended against `agent`: the
 /// reason it is never free for good, named as the open-ended lock or reservation itself
-/// (not whatever else overlaps its start). Falls back to what blocks at `from`.
+/// (not whatever else overlaps its start); a reservation only, unless `locked` (the locks
+/// are to blame). Falls back to what blocks at `from`.
 std::string forever_blocker_text(const topology::Topology& topology, const TimelineSet& timelines,
-                                 EntityIndex entity, std::string_view agent, TimeNs from) {
+                                 EntityIndex entity, std::string_view agent, TimeNs from,
+                                 bool locked) {
   const auto open_ended = first_blocker_text(
-      topology, timelines, entity, agent, [](const Interval& window) { return window.end == kForever; });
+      topology, timelines, entity, agent, [](const Interval& window) { return window.end == kForever; },
+      locked);
   return open_ended ? *open_ended : blocker_text(topology, timelines, entity, agent, from);
 }
 
@@ -321,7 +326,7 @@ struct Planner::Impl {
                               fmt::format("the last stop {} is never free for good (open-ended) from {} on: {}",
                                           vertex_name(last.vertex), time_text(from),
                                           forever_blocker_text(topology(), timelines, last.vertex,
-                                                               request.agent, from)));
+                                                               request.agent, from, locked)));
     if (!locked) {
       add_open_ended_holders(timelines, last.vertex, request.agent, failure.blockers);
       sort_unique(failure.blockers);

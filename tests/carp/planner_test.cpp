@@ -349,6 +349,12 @@ TEST(Planner, AGoalHeldForGoodIsExplainedByItsOpenEndedHold) {
   EXPECT_EQ(e.reason, PlanFailure::no_window);
   EXPECT_NE(e.message.find("agent b route 1001 holds '3,0' [7.000 s, forever)"), std::string::npos)
       << e.message;
+  // A lock for good there too does not change the reason, nor the hold named.
+  ASSERT_TRUE(w.timelines.lock(w.at("3,0"), {sec(20), kForever}, "op", "closed"));
+  const PlanError both = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "3,0")}));
+  EXPECT_EQ(both.reason, PlanFailure::no_window);
+  EXPECT_NE(both.message.find("agent b route 1001 holds '3,0' [7.000 s, forever)"), std::string::npos)
+      << both.message;
 }
 
 // A route a floor proof finds waits where it must, like the search's routes: it does not

@@ -45,10 +45,7 @@ int run(const LogicalAgentArguments& arguments) {
   make_agent_logger(arguments.vehicle_id, arguments.log_level);
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
-    }
-    return kExitBadInput;
+    return report_bad_file(arguments.topology_file, loaded.error());
   }
   logical_agent::LogicalAgentOptions options;
   if (!arguments.vehicle_file.empty()) {

@@ -57,10 +57,7 @@ int run(RanSimArguments arguments) {
                     arguments.log_level);
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {
-    for (const auto& problem : loaded.error()) {
-      std::cerr << "error: " << topology::diagnostic_text(arguments.topology_file, problem) << "\n";
-    }
-    return kExitBadInput;
+    return report_bad_file(arguments.topology_file, loaded.error());
   }
   auto world = std::make_shared<const topology::Topology>(std::move(*loaded));
   const auto at = world->find(arguments.at_vertex);
