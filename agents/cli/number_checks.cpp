@@ -16,8 +16,7 @@ namespace {
 /// The text CLI11 reads back as exactly `value`: an integer without a fraction where the
 /// value is whole and exact as a double, the shortest round trip otherwise.
 std::string plain(double value) {
-  constexpr double kExact = 9007199254740992.0;  // 2^53
-  if (value == std::floor(value) && std::abs(value) < kExact) {
+  if (value == std::floor(value) && std::abs(value) <= kLargestWholeOption) {
     return fmt::format("{}", static_cast<long long>(value));
   }
   return fmt::format("{}", value);

@@ -1,8 +1,5 @@
 #include "drover/carp/vehicle_profile_json.hpp"
 
-#include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
 
 #include "drover/common/json_syntax.hpp"

@@ -1,6 +1,5 @@
 #include "drover/topology/json_format.hpp"
 
-#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
