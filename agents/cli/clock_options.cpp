@@ -1,15 +1,20 @@
 #include "agents/cli/clock_options.hpp"
 
+#include "agents/cli/number_checks.hpp"
+
 namespace drover::cli {
 
 void add_clock_options(CLI::App& command, ClockArguments& arguments) {
   command.add_option("--time-factor", arguments.time_factor,
-                     "Shared-clock seconds per real second (default 1)");
+                     "Shared-clock seconds per real second (default 1)")
+      ->transform(positive());
   command.add_option("--epoch,--epoch-ns", arguments.epoch_ns,
-                     "Shared-clock time at the clock origin, ns (default: the Unix time then)");
+                     "Shared-clock time at the clock origin, ns (default: the Unix time then)")
+      ->transform(exact_whole_in(0, kLatestTimeOptionNs));
   command.add_option("--clock-origin", arguments.origin_unix_ns,
                      "Unix time, ns, at which the clock read --epoch (default: this process's "
-                     "start); the launcher gives every agent the same one");
+                     "start); the launcher gives every agent the same one")
+      ->transform(exact_whole_in(0, kLatestTimeOptionNs));
 }
 
 Result<SharedClock> make_clock(const ClockArguments& arguments) {

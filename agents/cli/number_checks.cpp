@@ -1,5 +1,6 @@
 #include "agents/cli/number_checks.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -78,5 +79,37 @@ CLI::Validator whole_in(long long low, long long high) {
 }
 
 CLI::Validator number_in(double low, double high) { return range_check(low, high, false); }
+
+CLI::Validator exact_whole_in(std::int64_t low, std::int64_t high) {
+  return CLI::Validator(
+      [=](std::string& input) -> std::string {
+        std::string_view digits = input;
+        const bool negative = !digits.empty() && digits.front() == '-';
+        if (!digits.empty() && (digits.front() == '+' || negative)) digits.remove_prefix(1);
+        const bool all_digits =
+            !digits.empty() && std::all_of(digits.begin(), digits.end(), [](char c) {
+              return std::isdigit(static_cast<unsigned char>(c)) != 0;
+            });
+        if (!all_digits) {
+          return parse_decimal(input) ? "must be a whole number in digits, got " + input
+                                      : "'" + input + "' is not a number";
+        }
+        const std::string range = fmt::format("must be from {} to {}, got {}", low, high, input);
+        std::uint64_t magnitude = 0;
+        const auto [end, error] =
+            std::from_chars(digits.data(), digits.data() + digits.size(), magnitude);
+        if (error != std::errc() || end != digits.data() + digits.size()) return range;
+        // Within int64 either way, so that the comparisons below are exact.
+        if (magnitude > std::uint64_t{1} << 63) return range;
+        const std::int64_t value =
+            negative ? static_cast<std::int64_t>(0 - magnitude) : static_cast<std::int64_t>(magnitude);
+        if ((!negative && magnitude == std::uint64_t{1} << 63) || value < low || value > high) {
+          return range;
+        }
+        input = fmt::format("{}", value);
+        return {};
+      },
+      fmt::format("INT in [{} - {}]", low, high));
+}
 
 }  // namespace drover::cli

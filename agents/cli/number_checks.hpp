@@ -5,6 +5,7 @@
 // it accepted into the plain decimal that CLI11 then converts to the value checked.
 // Add them with Option::transform: Option::check hands a validator a copy of the text.
 
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -15,6 +16,10 @@ namespace drover::cli {
 /// The largest value positive() and non_negative() accept: far beyond any duration, speed
 /// or factor an option gives, and small enough that seconds convert to nanoseconds.
 inline constexpr double kLargestOptionValue = 1e9;
+/// The latest shared-clock time, in ns, an option takes (about 73 years after the clock's
+/// zero): the route planner's carp::kLatestTime, so that sums of times stay far from
+/// overflow.
+inline constexpr std::int64_t kLatestTimeOptionNs = INT64_MAX / 4;
 /// The largest whole number every check reads exactly (2^53 - 1): for counts and seeds.
 inline constexpr long long kLargestWholeOption = (1LL << 53) - 1;
 
@@ -35,5 +40,9 @@ std::optional<double> parse_decimal(std::string_view text);
 CLI::Validator whole_in(long long low, long long high);
 /// A finite number in [low, high].
 CLI::Validator number_in(double low, double high);
+/// A whole number in [low, high] read exactly as a 64-bit integer, for nanosecond times
+/// beyond 2^53 that whole_in would round: an optional sign and decimal digits only (no
+/// fraction, no exponent), leading zeros allowed ("010" is ten). \pre low <= high
+CLI::Validator exact_whole_in(std::int64_t low, std::int64_t high);
 
 }  // namespace drover::cli

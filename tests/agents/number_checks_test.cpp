@@ -3,6 +3,7 @@
 
 #include "agents/cli/number_checks.hpp"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,40 @@ TEST(NumberChecks, DecimalsInsideOptionValuesAreReadTheSameWay) {
   EXPECT_EQ(parse_decimal("010"), 10.0);
   for (const char* text : {"0x5", " 1", "1 ", "inf", "", "+-1", "5s"}) {
     EXPECT_FALSE(parse_decimal(text).has_value()) << text;
+  }
+}
+
+TEST(NumberChecks, NanosecondTimesAreReadExactlyBeyondWhatADoubleHolds) {
+  std::int64_t ns = 0;
+  // 2^53 + 1: a double would read 9007199254740992.
+  EXPECT_EQ(parse("9007199254740993", exact_whole_in(0, INT64_MAX), ns), "");
+  EXPECT_EQ(ns, 9007199254740993);
+  EXPECT_EQ(parse("0001800000000000000001", exact_whole_in(0, INT64_MAX), ns), "");
+  EXPECT_EQ(ns, 1800000000000000001) << "leading zeros are not octal";
+  EXPECT_EQ(parse("9223372036854775807", exact_whole_in(0, INT64_MAX), ns), "");
+  EXPECT_EQ(ns, INT64_MAX);
+  EXPECT_EQ(parse("-9223372036854775808", exact_whole_in(INT64_MIN, 0), ns), "");
+  EXPECT_EQ(ns, INT64_MIN);
+  EXPECT_EQ(parse("+12", exact_whole_in(0, 100), ns), "");
+  EXPECT_EQ(ns, 12);
+}
+
+TEST(NumberChecks, NanosecondTimesOutOfRangeOrNotInDigitsAreRefused) {
+  std::int64_t ns = 0;
+  EXPECT_NE(parse("9223372036854775808", exact_whole_in(0, INT64_MAX), ns)
+                .find("must be from 0 to 9223372036854775807, got 9223372036854775808"),
+            std::string::npos);
+  EXPECT_NE(parse("99999999999999999999999", exact_whole_in(0, 100), ns).find("must be from 0 to 100"),
+            std::string::npos);
+  EXPECT_NE(parse("-1", exact_whole_in(0, 100), ns).find("must be from 0 to 100, got -1"),
+            std::string::npos);
+  EXPECT_NE(parse("1e9", exact_whole_in(0, INT64_MAX), ns).find("must be a whole number in digits, got 1e9"),
+            std::string::npos);
+  EXPECT_NE(parse("1.0", exact_whole_in(0, INT64_MAX), ns).find("must be a whole number in digits"),
+            std::string::npos);
+  for (const char* text : {"0x10", "abc", "", "-", "+", "+-1", " 5", "5 "}) {
+    SCOPED_TRACE(text);
+    EXPECT_NE(parse(text, exact_whole_in(0, INT64_MAX), ns).find("is not a number"), std::string::npos);
   }
 }
 

@@ -133,7 +133,16 @@ TEST(LaunchFile, LogicalAgentFieldsOutOfRange) {
       {"kind": "logical", "vehicle": "V1", "lookahead": 0, "charge_below": 1.5, "charge_to": -0.1})"));
   EXPECT_NE(text.find("agents[3].lookahead: must be an integer >= 1"), std::string::npos) << text;
   EXPECT_NE(text.find("agents[3].charge_below: must be a number from 0 to 1"), std::string::npos) << text;
-  EXPECT_NE(text.find("agents[3].charge_to: must be a number from 0 to 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].charge_to: must be a number > 0 and at most 1"), std::string::npos) << text;
+}
+
+// The logical agent refuses to charge to 0 (it would never charge); refused before anything starts.
+TEST(LaunchFile, ChargingToZeroIsRefused) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
+      {"kind": "logical", "vehicle": "V1", "charge_below": 0, "charge_to": 0})"));
+  EXPECT_NE(text.find("agents[3].charge_to: must be a number > 0 and at most 1"), std::string::npos) << text;
+  EXPECT_EQ(text.find("charge_below"), std::string::npos) << "0 means never: " << text;
 }
 
 TEST(LaunchFile, VerticesPartitionsAndProfilesMustExist) {

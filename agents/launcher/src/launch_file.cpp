@@ -30,6 +30,7 @@ enum class FieldType {
   count,            ///< an integer >= 0
   positive_count,   ///< an integer >= 1
   fraction,         ///< a number in [0, 1]
+  positive_fraction,  ///< a number in (0, 1]
   flag,             ///< true adds the option without a value; false leaves it out
   journal,          ///< a file path; relative ones are relative to the state directory
 };
@@ -92,7 +93,7 @@ const std::vector<KindRules>& kind_rules() {
         {"delay_threshold", "--delay-threshold", FieldType::positive_number},
         {"park_after", "--park-after", FieldType::number},
         {"charge_below", "--charge-below", FieldType::fraction},
-        {"charge_to", "--charge-to", FieldType::fraction},
+        {"charge_to", "--charge-to", FieldType::positive_fraction},
         {"error_limit", "--error-limit", FieldType::positive_number},
         {"route_limit", "--route-limit", FieldType::number},
         {"log_level", "--log-level", FieldType::text}}},
@@ -447,11 +448,16 @@ class LaunchFileParser {
         options.insert(options.end(), {option, format_number(value.get<double>())});
         return;
       case FieldType::fraction:
-        if (!value.is_number() || !(value.get<double>() >= 0.0 && value.get<double>() <= 1.0)) {
-          return checker_.problem(where, "must be a number from 0 to 1");
+      case FieldType::positive_fraction: {
+        const bool zero_allowed = rule.type == FieldType::fraction;
+        if (!value.is_number() || !(value.get<double>() >= 0.0 && value.get<double>() <= 1.0) ||
+            (!zero_allowed && value.get<double>() == 0.0)) {
+          return checker_.problem(where, zero_allowed ? "must be a number from 0 to 1"
+                                                      : "must be a number > 0 and at most 1");
         }
         options.insert(options.end(), {option, format_number(value.get<double>())});
         return;
+      }
       case FieldType::count:
       case FieldType::positive_count: {
         const std::int64_t least = rule.type == FieldType::count ? 0 : 1;

@@ -114,11 +114,13 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
                       "s of lateness at the next vertex before a delay is propagated (default 2)")
       ->transform(cli::positive());
   command->add_option("--park-after", arguments->park_after,
-                      "s idle before driving to a parking vertex; negative: never (default 30)");
+                      "s idle before driving to a parking vertex; negative: never (default 30)")
+      ->transform(cli::number_in(-cli::kLargestOptionValue, cli::kLargestOptionValue));
   command->add_option("--charge-below", arguments->charge_below,
                       "State of charge under which it charges before new work; 0: never (default 0.2)")
       ->transform(cli::number_in(0.0, 1.0));
-  command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at (default 0.9)");
+  command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at, > 0 (default 0.9)")
+      ->transform(cli::number_in(0.0, 1.0));  // and not 0: checked in run()
   command->add_option("--error-limit", arguments->error_limit,
                       "s a recoverable RAN error may last before the order fails (default 60)")
       ->transform(cli::positive());
