@@ -6,15 +6,15 @@ namespace drover::cli {
 
 void add_clock_options(CLI::App& command, ClockArguments& arguments) {
   command.add_option("--time-factor", arguments.time_factor,
-                     "Shared-clock seconds per real second (default 1)")
-      ->transform(positive());
+                     "Shared-clock seconds per real second, at most 1000 (default 1)")
+      ->transform(positive_at_most(kMaxTimeFactor));
   command.add_option("--epoch,--epoch-ns", arguments.epoch_ns,
                      "Shared-clock time at the clock origin, ns (default: the Unix time then)")
-      ->transform(exact_whole_in(0, kLatestTimeOptionNs));
+      ->transform(exact_whole_in(0, kLatestTime));
   command.add_option("--clock-origin", arguments.origin_unix_ns,
                      "Unix time, ns, at which the clock read --epoch (default: this process's "
                      "start); the launcher gives every agent the same one")
-      ->transform(exact_whole_in(0, kLatestTimeOptionNs));
+      ->transform(exact_whole_in(0, kLatestTime));
 }
 
 Result<SharedClock> make_clock(const ClockArguments& arguments) {
@@ -24,7 +24,7 @@ Result<SharedClock> make_clock(const ClockArguments& arguments) {
   const TimeNs origin = arguments.origin_unix_ns.value_or(SharedClock::unix_now());
   auto clock = SharedClock::create_at_origin(arguments.epoch_ns.value_or(origin),
                                              arguments.time_factor, origin);
-  if (!clock) return fail(ErrorCode::invalid_argument, "--time-factor: " + clock.error().message);
+  if (!clock) return fail(ErrorCode::invalid_argument, "clock: " + clock.error().message);
   return clock;
 }
 

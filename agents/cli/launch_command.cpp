@@ -126,7 +126,7 @@ int run(const LaunchArguments& arguments) {
   const TimeNs epoch = file->epoch_ns.value_or(origin);
   auto clock = SharedClock::create_at_origin(epoch, file->time_factor, origin);
   if (!clock) {
-    std::cerr << "error: --time-factor: " << clock.error().message << "\n";
+    std::cerr << "error: clock: " << clock.error().message << "\n";
     return kExitBadInput;
   }
   auto executable = launcher::current_executable();
@@ -221,8 +221,8 @@ void add_launch_command(CLI::App& app, CommandContext& context) {
   command->add_option("--duration", arguments->duration_s, "Stop after this many simulated seconds")
       ->transform(cli::positive());
   command->add_option("--time-factor", arguments->time_factor,
-                      "Shared-clock seconds per real second (overrides the launch file's)")
-      ->transform(cli::positive());
+                      "Shared-clock seconds per real second, at most 1000 (overrides the launch file's)")
+      ->transform(cli::positive_at_most(kMaxTimeFactor));
   command->add_option("--domain", arguments->domain_id, "DDS domain id (overrides the launch file's)")
       ->transform(cli::whole_in(0, 232));
   command->add_option("--trace", arguments->trace_file,

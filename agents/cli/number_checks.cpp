@@ -25,14 +25,14 @@ std::string plain(double value) {
 
 enum class Sign { positive, non_negative };
 
-CLI::Validator sign_check(Sign sign) {
+CLI::Validator sign_check(Sign sign, double largest = kLargestOptionValue) {
   return CLI::Validator(
-      [sign](std::string& input) -> std::string {
+      [sign, largest](std::string& input) -> std::string {
         const auto value = parse_decimal(input);
         if (!value) return "'" + input + "' is not a number";
         const bool fine = sign == Sign::positive ? *value > 0 : *value >= 0;
         if (!fine) return std::string(sign == Sign::positive ? "must be > 0" : "must be >= 0") + ", got " + input;
-        if (*value > kLargestOptionValue) return "must be at most " + plain(kLargestOptionValue) + ", got " + input;
+        if (*value > largest) return "must be at most " + plain(largest) + ", got " + input;
         input = plain(*value);
         return {};
       },
@@ -71,6 +71,8 @@ std::optional<double> parse_decimal(std::string_view text) {
 }
 
 CLI::Validator positive() { return sign_check(Sign::positive); }
+
+CLI::Validator positive_at_most(double largest) { return sign_check(Sign::positive, largest); }
 
 CLI::Validator non_negative() { return sign_check(Sign::non_negative); }
 

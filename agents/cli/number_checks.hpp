@@ -16,16 +16,14 @@ namespace drover::cli {
 /// The largest value positive() and non_negative() accept: far beyond any duration, speed
 /// or factor an option gives, and small enough that seconds convert to nanoseconds.
 inline constexpr double kLargestOptionValue = 1e9;
-/// The latest shared-clock time, in ns, an option takes (about 73 years after the clock's
-/// zero): the route planner's carp::kLatestTime, so that sums of times stay far from
-/// overflow.
-inline constexpr std::int64_t kLatestTimeOptionNs = INT64_MAX / 4;
 /// The largest whole number every check reads exactly (2^53 - 1): for counts and seeds.
 inline constexpr long long kLargestWholeOption = (1LL << 53) - 1;
 
 /// The number must be > 0 and at most kLargestOptionValue ("must be > 0, got 0"; CLI11's
 /// PositiveNumber names a range from 0 to 1.8e308 instead).
 CLI::Validator positive();
+/// The number must be > 0 and at most `largest`. \pre 0 < largest <= kLargestOptionValue
+CLI::Validator positive_at_most(double largest);
 /// The number must be >= 0 and at most kLargestOptionValue.
 CLI::Validator non_negative();
 

@@ -125,7 +125,7 @@ void add_route_command(CLI::App& app, CommandContext& context) {
   command->add_option("--vehicle", arguments->vehicle_file, "Vehicle profile JSON file (default: carp defaults)");
   command->add_option("--start-time", arguments->start_time,
                       "Shared-clock start time, ns (default: now on the routing agent's clock)")
-      ->transform(cli::exact_whole_in(0, cli::kLatestTimeOptionNs));
+      ->transform(cli::exact_whole_in(0, kLatestTime));
   command->add_option("--dwell", arguments->dwell_seconds,
                       "Hold the destination this many seconds (default: open-ended, until the next route)")
       ->transform(cli::positive());

@@ -166,8 +166,8 @@ struct Planner::Impl {
 
   std::string vertex_name(EntityIndex v) const { return "'" + topology().id(v) + "'"; }
 
-  /// How long after its start time a route may take: the option, cut to kLatestTime.
-  DurationNs horizon() const { return std::min(options.horizon, kLatestTime); }
+  /// How long after its start time a route may take: the option, cut to kLongestDuration.
+  DurationNs horizon() const { return std::min(options.horizon, kLongestDuration); }
 
   std::optional<PlanError> check_request(const TimelineSet& timelines,
                                          const PlanRequest& request) const {
@@ -203,14 +203,15 @@ struct Planner::Impl {
     };
     if (request.start >= topology().vertex_count()) return not_vertex(request.start, "start");
     if (request.start_time < 0 || request.start_time > kLatestTime) {
-      return invalid(fmt::format("start time {} ns is out of range", request.start_time));
+      return invalid(fmt::format("start time {} ns is out of range (0 to {} ns)", request.start_time,
+                                 kLatestTime));
     }
     if (request.stops.empty()) return invalid("the request has no stops");
     if (request.stops.size() > kMaxStops) {
       return invalid(fmt::format("the request has {} stops, more than the {} one request may have",
                                  request.stops.size(), kMaxStops));
     }
-    DurationNs dwells = 0;  // at most kLatestTime + one dwell: no overflow
+    DurationNs dwells = 0;  // at most kLongestDuration + one dwell: no overflow
     for (std::size_t k = 0; k < request.stops.size(); ++k) {
       // The stop's name is formatted only for an error: every plan passes here.
       const Stop& stop = request.stops[k];
@@ -219,17 +220,17 @@ struct Planner::Impl {
       }
       if (!stop.dwell) continue;
       const bool last = k + 1 == request.stops.size();
-      if (*stop.dwell < 0 || (last && *stop.dwell == 0) || *stop.dwell > kLatestTime) {
+      if (*stop.dwell < 0 || (last && *stop.dwell == 0) || *stop.dwell > kLongestDuration) {
         return invalid(fmt::format("stop {} ({}): dwell {} ns must be {} (and not huge)", k,
                                    vertex_name(stop.vertex), *stop.dwell,
                                    last ? "> 0 for the last stop, or absent for an open-ended hold"
                                         : ">= 0"));
       }
       dwells += *stop.dwell;
-      if (dwells > kLatestTime) {
+      if (dwells > kLongestDuration) {
         return invalid(fmt::format("the dwells of stops 0 to {} add up to more than {}, the "
                                    "longest the planner takes",
-                                   k, time_text(kLatestTime)));
+                                   k, time_text(kLongestDuration)));
       }
     }
     return std::nullopt;

@@ -38,10 +38,10 @@ class Traversal {
   DurationNs min_travel() const { return min_travel_; }
 
   /// The most a travel() or clearance() may take on a graph of `vertex_count` vertices:
-  /// then no path's travel time (at most one arc per vertex) passes kLatestTime, and the
+  /// then no path's travel time (at most one arc per vertex) passes kLongestDuration, and the
   /// searches' sums of times and durations stay far from overflowing.
   static DurationNs max_arc_time(std::size_t vertex_count) {
-    return kLatestTime / static_cast<DurationNs>(std::max<std::size_t>(vertex_count, 1));
+    return kLongestDuration / static_cast<DurationNs>(std::max<std::size_t>(vertex_count, 1));
   }
   /// Why vehicle `vehicle_id` (of this class) cannot be planned for on `graph` (the one
   /// the traversal was built for), if so: on some arc it may drive, its travel or clearance

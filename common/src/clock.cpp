@@ -3,12 +3,18 @@
 #include <cmath>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace drover {
 
 Result<SharedClock> SharedClock::create(TimeNs epoch_ns, double factor) {
-  if (!(factor > 0.0) || !std::isfinite(factor)) {
+  if (!(factor > 0.0 && factor <= kMaxTimeFactor)) {
     return fail(ErrorCode::invalid_argument,
-                "time factor must be a positive finite number, got " + std::to_string(factor));
+                fmt::format("time factor must be > 0 and at most {}, got {}", kMaxTimeFactor, factor));
+  }
+  if (epoch_ns < 0 || epoch_ns > kLatestTime) {
+    return fail(ErrorCode::invalid_argument,
+                fmt::format("epoch must be from 0 to {} ns, got {}", kLatestTime, epoch_ns));
   }
   return SharedClock(epoch_ns, factor, std::chrono::steady_clock::now());
 }
@@ -17,6 +23,10 @@ Result<SharedClock> SharedClock::create_at_origin(TimeNs epoch_ns, double factor
                                                   TimeNs origin_unix_ns) {
   auto clock = create(epoch_ns, factor);
   if (!clock) return clock;
+  if (origin_unix_ns < 0 || origin_unix_ns > kLatestTime) {
+    return fail(ErrorCode::invalid_argument,
+                fmt::format("clock origin must be from 0 to {} ns, got {}", kLatestTime, origin_unix_ns));
+  }
   // The steady-clock instant at which the clock read epoch_ns: as long before now as the
   // origin lies before the Unix time now (after it, for an origin in the future).
   const auto since_origin = std::chrono::nanoseconds(unix_now() - origin_unix_ns);

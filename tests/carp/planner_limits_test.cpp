@@ -148,9 +148,9 @@ TEST(PlannerLimits, MoreStopsThanOneRequestMayHaveAreRefused) {
   EXPECT_TRUE(mentions(error, std::to_string(kMaxStops + 1) + " stops")) << error.message;
 }
 
-TEST(PlannerLimits, DwellsAddingUpPastTheLatestTimeAreRefused) {
+TEST(PlannerLimits, DwellsAddingUpPastTheLongestDurationAreRefused) {
   World w(GridBuilder().corridor(3).build(), PlannerOptions{.horizon = kForever});
-  const DurationNs half = kLatestTime / 2;
+  const DurationNs half = kLongestDuration / 2;
   std::vector<Stop> stops{{w.at("2,0"), half}, {w.at("1,0"), half}, {w.at("2,0"), half},
                           {w.at("0,0"), std::nullopt}};
   const PlanError error = plan_error(w, request_to(w, "a", "0,0", stops));
@@ -158,11 +158,11 @@ TEST(PlannerLimits, DwellsAddingUpPastTheLatestTimeAreRefused) {
   EXPECT_TRUE(mentions(error, "dwells of stops 0 to 2")) << error.message;
 }
 
-// A horizon longer than kLatestTime counts as kLatestTime, and says so; stops that cannot
-// fit into it even on an empty map fail before any search.
+// A horizon longer than kLongestDuration counts as kLongestDuration, and says so; stops
+// that cannot fit into it even on an empty map fail before any search.
 TEST(PlannerLimits, TheHorizonReportedIsTheOneApplied) {
   World w(GridBuilder().corridor(3).build(), PlannerOptions{.horizon = kForever});
-  const std::vector<Stop> stops{{w.at("2,0"), kLatestTime}, {w.at("0,0"), std::nullopt}};
+  const std::vector<Stop> stops{{w.at("2,0"), kLongestDuration}, {w.at("0,0"), std::nullopt}};
   const PlanError error = plan_error(w, request_to(w, "a", "0,0", stops));
   EXPECT_EQ(error.reason, PlanFailure::no_window) << error.message;
   EXPECT_TRUE(mentions(error, "even on an empty topology")) << error.message;
@@ -175,6 +175,27 @@ TEST(PlannerLimits, TheHorizonReportedIsTheOneApplied) {
       short_horizon, request_to(short_horizon, "a", "0,0", {open_stop(short_horizon, "2,0")}));
   EXPECT_EQ(too_far.reason, PlanFailure::no_window) << too_far.message;
   EXPECT_TRUE(mentions(too_far, "within the horizon of 2.500 s")) << too_far.message;
+}
+
+// A plant's shared clock reads Unix time: routes start until 2116 (kLatestTime), with the
+// longest horizon and dwells on top and no sum overflowing (UBSan in the sanitized stage).
+TEST(PlannerLimits, RoutesStartUntilTheLatestTimeWithTheLongestDurationsOnTop) {
+  World w(GridBuilder().corridor(3).build(), PlannerOptions{.horizon = kForever});
+  const TimeNs year_2100 = 4'102'444'800 * kNsPerSecond;  // 2100-01-01T00:00:00Z
+  for (const TimeNs start : {year_2100, kLatestTime}) {
+    SCOPED_TRACE(start);
+    const auto planned = w.planner.plan(
+        w.timelines, request_to(w, "a", "0,0",
+                                {{w.at("2,0"), kLongestDuration / 2}, {w.at("0,0"), kLongestDuration / 2}},
+                                start));
+    ASSERT_TRUE(planned.has_value()) << planned.error().message;
+    EXPECT_EQ(planned->steps.front().window.start, start);
+    EXPECT_EQ(planned->stop_arrivals[0], start + sec(2));
+    EXPECT_EQ(planned->arrival, start + sec(4) + kLongestDuration / 2);
+  }
+  const PlanError late = plan_error(w, request_to(w, "a", "0,0", {open_stop(w, "2,0")}, kLatestTime + 1));
+  EXPECT_EQ(late.reason, PlanFailure::invalid_request) << late.message;
+  EXPECT_TRUE(mentions(late, "out of range (0 to " + std::to_string(kLatestTime) + " ns)")) << late.message;
 }
 
 // A set owning part of the topology sees the rest as another's: the planner would blame a

@@ -102,9 +102,17 @@ TEST(LaunchFile, MissingOrBadHeaderFields) {
   const auto bad = problems_of(R"({"domain": 233, "time_factor": -1, "epoch": "soon", "topology": "topologies/loop.json",
                                    "agents": [{"kind": "routing"}], "colour": "red"})");
   EXPECT_NE(bad.find("domain: must be an integer DDS domain id in 0..232"), std::string::npos) << bad;
-  EXPECT_NE(bad.find("time_factor: must be a positive number"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("time_factor: must be a number > 0 and at most 1000"), std::string::npos) << bad;
   EXPECT_NE(bad.find("epoch: must be \"now\" or an integer"), std::string::npos) << bad;
   EXPECT_NE(bad.find("colour: unknown field"), std::string::npos) << bad;
+  // Beyond what a shared clock runs at or starts from (it would overflow), and beyond int64.
+  for (const char* epoch : {"-1", "4611686018427387904", "18446744073709551615", "1e30", "1.5"}) {
+    const auto huge = problems_of(std::string(R"({"time_factor": 1001, "epoch": )") + epoch +
+                                  R"(, "topology": "topologies/loop.json", "agents": [{"kind": "routing"}]})");
+    EXPECT_NE(huge.find("time_factor: must be a number > 0 and at most 1000"), std::string::npos) << huge;
+    EXPECT_NE(huge.find("epoch: must be \"now\" or an integer from 0 to 4611686018427387903"), std::string::npos)
+        << epoch << ": " << huge;
+  }
   const auto no_agents = problems_of(R"({"topology": "topologies/loop.json", "agents": []})");
   EXPECT_NE(no_agents.find("agents: must be a non-empty array"), std::string::npos) << no_agents;
 }

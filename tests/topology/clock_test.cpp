@@ -1,3 +1,5 @@
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "drover/common/clock.hpp"
@@ -9,6 +11,20 @@ TEST(SharedClock, RejectsNonPositiveFactor) {
   EXPECT_FALSE(SharedClock::create(0, 0.0).has_value());
   EXPECT_FALSE(SharedClock::create(0, -2.0).has_value());
   EXPECT_EQ(SharedClock::create(0, -2.0).error().code, ErrorCode::invalid_argument);
+  EXPECT_FALSE(SharedClock::create(0, std::nan("")).has_value());
+}
+
+// Faster clocks, or later epochs, would overflow int64 nanoseconds within weeks.
+TEST(SharedClock, RejectsFactorsAndTimesItCouldOverflowWith) {
+  EXPECT_TRUE(SharedClock::create(kLatestTime, kMaxTimeFactor).has_value());
+  const auto fast = SharedClock::create(0, kMaxTimeFactor * 1.5);
+  ASSERT_FALSE(fast.has_value());
+  EXPECT_NE(fast.error().message.find("at most 1000, got 1500"), std::string::npos) << fast.error().message;
+  EXPECT_FALSE(SharedClock::create(0, INFINITY).has_value());
+  EXPECT_FALSE(SharedClock::create(kLatestTime + 1, 1.0).has_value());
+  EXPECT_FALSE(SharedClock::create(-1, 1.0).has_value());
+  EXPECT_FALSE(SharedClock::create_at_origin(0, 1.0, -1).has_value());
+  EXPECT_FALSE(SharedClock::create_at_origin(0, 1.0, kLatestTime + 1).has_value());
 }
 
 TEST(SharedClock, ScalesRealTimeByFactor) {

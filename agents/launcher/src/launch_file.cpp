@@ -6,8 +6,10 @@
 #include <set>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "drover/common/clock.hpp"
 #include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
@@ -212,17 +214,21 @@ class LaunchFileParser {
       }
     }
     if (auto factor = root.find("time_factor"); factor != root.end()) {
-      if (factor->is_number() && std::isfinite(factor->get<double>()) && factor->get<double>() > 0) {
+      if (factor->is_number() && factor->get<double>() > 0 && factor->get<double>() <= kMaxTimeFactor) {
         file_.time_factor = factor->get<double>();
       } else {
-        checker_.problem("time_factor", "must be a positive number (shared-clock seconds per real second)");
+        checker_.problem("time_factor", fmt::format("must be a number > 0 and at most {} (shared-clock "
+                                                    "seconds per real second)", kMaxTimeFactor));
       }
     }
     if (auto epoch = root.find("epoch"); epoch != root.end()) {
-      if (epoch->is_number_integer()) {
+      // A number beyond int64 is unsigned (too large) or a float: refused either way.
+      if (epoch->is_number_integer() && !(epoch->is_number_unsigned() && epoch->get<std::uint64_t>() > kLatestTime) &&
+          epoch->get<std::int64_t>() >= 0 && epoch->get<std::int64_t>() <= kLatestTime) {
         file_.epoch_ns = epoch->get<TimeNs>();
       } else if (!(epoch->is_string() && epoch->get<std::string>() == "now")) {
-        checker_.problem("epoch", "must be \"now\" or an integer (shared-clock nanoseconds at start)");
+        checker_.problem("epoch", fmt::format("must be \"now\" or an integer from 0 to {} (shared-clock "
+                                              "nanoseconds at start)", kLatestTime));
       }
     }
     const auto topology = root.find("topology");

@@ -12,7 +12,7 @@ namespace drover::carp {
 
 struct PlannerOptions {
   /// Routes must reach every stop within start_time + horizon (the search gives up on
-  /// later windows and reports no_window). > 0; longer than kLatestTime counts as it.
+  /// later windows and reports no_window). > 0; longer than kLongestDuration counts as it.
   DurationNs horizon = 3600 * kNsPerSecond;
   /// How many heuristic tables (one per goal and vehicle class) are kept between calls.
   std::size_t heuristic_tables = 64;

@@ -13,10 +13,12 @@
 
 namespace drover::carp {
 
-/// The latest start time, the longest dwell, the longest sum of a request's dwells and the
-/// longest horizon the planner takes (about 73 years; a longer horizon is cut to it), so
-/// that its sums of times never overflow.
-inline constexpr TimeNs kLatestTime = kForever / 4;
+/// The longest dwell, the longest sum of a request's dwells, the longest horizon (a longer
+/// one is cut to it) and the longest travel time of a path the planner takes: an eighth of
+/// the TimeNs range, about 36 years. With start times up to kLatestTime (half the range, in
+/// drover/common/clock.hpp) no sum of the planner's times overflows: a start time and four
+/// such durations at most.
+inline constexpr DurationNs kLongestDuration = kForever / 8;
 /// The most stops one request may have: a search keeps a little for every (stop, vertex)
 /// pair, 8 bytes, so 1 024 stops on a map of 100 000 vertices take 800 MB.
 inline constexpr std::size_t kMaxStops = 1024;

@@ -21,6 +21,15 @@ inline constexpr TimeNs kForever = std::numeric_limits<TimeNs>::max();
 
 inline constexpr DurationNs kNsPerSecond = 1'000'000'000;
 
+/// The latest time a shared clock may start at and that agents take as a start time: half
+/// the TimeNs range, about 146 years after the clock's zero (the year 2116 on a clock that
+/// reads Unix time, as a plant's does), so that such a time plus durations of decades never
+/// overflows.
+inline constexpr TimeNs kLatestTime = kForever / 2;
+/// The fastest a shared clock may run, in shared-clock seconds per real second: from an
+/// epoch up to kLatestTime it reads the end of the TimeNs range no sooner than 53 days later.
+inline constexpr double kMaxTimeFactor = 1000;
+
 /// Seconds (double) to nanoseconds, rounded to the nearest nanosecond.
 constexpr DurationNs seconds_to_ns(double seconds) noexcept {
   return static_cast<DurationNs>(seconds * 1e9 + (seconds >= 0 ? 0.5 : -0.5));
@@ -33,8 +42,10 @@ class SharedClock {
  public:
   /// \param epoch_ns  shared-clock time at the moment this clock is constructed
   ///                  (the launcher passes the same value to every process).
-  /// \param factor    how many shared-clock seconds pass per real second; must be > 0.
-  /// \return the clock, or invalid_argument when factor is not positive and finite.
+  /// \param factor    how many shared-clock seconds pass per real second; in
+  ///                  (0, kMaxTimeFactor].
+  /// \return the clock, or invalid_argument when factor is out of range or epoch_ns is not
+  ///         in [0, kLatestTime].
   static Result<SharedClock> create(TimeNs epoch_ns, double factor);
 
   /// A clock that read `epoch_ns` at the real Unix time `origin_unix_ns` (ns since 1970)
@@ -42,7 +53,8 @@ class SharedClock {
   /// the time however late each of them starts (up to their hosts' system clocks): this is
   /// how the launcher gives every agent one clock. The system clock is read once, here;
   /// afterwards the clock follows the steady clock, so it never jumps.
-  /// \return the clock, or invalid_argument when factor is not positive and finite.
+  /// \return the clock, or invalid_argument as create() says, or when origin_unix_ns is not
+  ///         in [0, kLatestTime].
   static Result<SharedClock> create_at_origin(TimeNs epoch_ns, double factor, TimeNs origin_unix_ns);
 
   /// A clock with epoch = the Unix time now and factor 1 (a plant).
