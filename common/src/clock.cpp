@@ -30,6 +30,16 @@ Result<SharedClock> SharedClock::create_at_origin(TimeNs epoch_ns, double factor
   // The steady-clock instant at which the clock read epoch_ns: as long before now as the
   // origin lies before the Unix time now (after it, for an origin in the future).
   const auto since_origin = std::chrono::nanoseconds(unix_now() - origin_unix_ns);
+  // What it reads now must be a time too: an origin long past at a high factor would put
+  // it beyond int64 at once. (Slightly negative is fine: a host whose system clock is
+  // behind the launcher's, with epoch 0.)
+  const double reading = static_cast<double>(epoch_ns) + factor * static_cast<double>(since_origin.count());
+  if (!(std::abs(reading) <= static_cast<double>(kLatestTime))) {
+    return fail(ErrorCode::invalid_argument,
+                fmt::format("a clock that read {} ns at Unix time {} ns and runs {} times as fast would "
+                            "read {:.0f} ns now, beyond {} ns",
+                            epoch_ns, origin_unix_ns, factor, reading, kLatestTime));
+  }
   return SharedClock(epoch_ns, factor, std::chrono::steady_clock::now() - since_origin);
 }
 

@@ -139,9 +139,30 @@ TEST(LaunchFile, LogicalAgentFieldsOutOfRange) {
   const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
       {"kind": "logical", "vehicle": "V1", "lookahead": 0, "charge_below": 1.5, "charge_to": -0.1})"));
-  EXPECT_NE(text.find("agents[3].lookahead: must be an integer >= 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[3].lookahead: must be an integer from 1 to 1000"), std::string::npos) << text;
   EXPECT_NE(text.find("agents[3].charge_below: must be a number from 0 to 1"), std::string::npos) << text;
   EXPECT_NE(text.find("agents[3].charge_to: must be a number > 0 and at most 1"), std::string::npos) << text;
+}
+
+// Every numeric field has the range of the option it becomes: a value beyond it would start
+// the fleet and then stop the agent that refuses it.
+TEST(LaunchFile, NumbersBeyondWhatTheirAgentTakesAreRefused) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "heading": 1001, "status_period_ms": 0},
+      {"kind": "logical", "vehicle": "V1", "lookahead": 1001, "park_after": 2e9, "route_limit": -1,
+       "delay_threshold": 1e10, "error_limit": 0},
+      {"kind": "load-generator", "seed": 18446744073709551615, "max_orders": -1})"));
+  for (const char* expected : {"agents[2].heading: must be a number from -1000 to 1000",
+                               "agents[2].status_period_ms: must be an integer from 1 to 60000",
+                               "agents[3].lookahead: must be an integer from 1 to 1000",
+                               "agents[3].park_after: must be a number from -1000000000 to 1000000000",
+                               "agents[3].route_limit: must be a number from 0 to 1000000000",
+                               "agents[3].delay_threshold: must be a number > 0 and at most 1000000000",
+                               "agents[3].error_limit: must be a number > 0 and at most 1000000000",
+                               "agents[4].seed: must be an integer from 0 to 9007199254740991",
+                               "agents[4].max_orders: must be an integer from 0 to 9007199254740991"}) {
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << "\n" << text;
+  }
 }
 
 // The logical agent refuses to charge to 0 (it would never charge); refused before anything starts.

@@ -25,6 +25,14 @@ TEST(SharedClock, RejectsFactorsAndTimesItCouldOverflowWith) {
   EXPECT_FALSE(SharedClock::create(-1, 1.0).has_value());
   EXPECT_FALSE(SharedClock::create_at_origin(0, 1.0, -1).has_value());
   EXPECT_FALSE(SharedClock::create_at_origin(0, 1.0, kLatestTime + 1).has_value());
+  // Epoch and origin in range, but at factor 6 the Unix time since 1970 is beyond int64.
+  const auto since_1970 = SharedClock::create_at_origin(0, 6.0, 0);
+  ASSERT_FALSE(since_1970.has_value());
+  EXPECT_NE(since_1970.error().message.find("would read"), std::string::npos) << since_1970.error().message;
+  // An origin in the future (another host's system clock ahead) reads a little before the epoch.
+  auto ahead = SharedClock::create_at_origin(0, 10.0, SharedClock::unix_now() + 1'000'000);
+  ASSERT_TRUE(ahead.has_value());
+  EXPECT_LT(ahead->now(), 10'000'000);
 }
 
 TEST(SharedClock, ScalesRealTimeByFactor) {

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/number_checks.hpp"
 #include "drover/common/clock.hpp"
 #include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
@@ -27,21 +28,25 @@ enum class FieldType {
   vertex,           ///< the id of a vertex of the topology
   vertex_list,      ///< a non-empty array of vertex ids (one option per id)
   partition,        ///< a partition named by the topology
-  number,           ///< a finite number
-  positive_number,  ///< a finite number > 0
-  count,            ///< an integer >= 0
-  positive_count,   ///< an integer >= 1
-  fraction,         ///< a number in [0, 1]
-  positive_fraction,  ///< a number in (0, 1]
+  number,           ///< a number in [least, most]
+  positive_number,  ///< a number in (0, most]
+  count,            ///< an integer in [least, most]
   flag,             ///< true adds the option without a value; false leaves it out
   journal,          ///< a file path; relative ones are relative to the state directory
 };
 
+/// The ranges are the ones the subcommand's option takes (agents/cli/number_checks.hpp):
+/// a value it would refuse is refused in the file, so that nothing is started.
 struct FieldRule {
   std::string_view key;
   std::string_view option;  ///< the subcommand's option it becomes
   FieldType type;
+  double least = 0;                           ///< number, count
+  double most = cli::kLargestOptionValue;     ///< number, positive_number, count
 };
+
+constexpr double kLargest = cli::kLargestOptionValue;
+constexpr auto kLargestWhole = static_cast<double>(cli::kLargestWholeOption);
 
 /// The fields a vehicle profile may set, and the ran-sim options they become (none: the
 /// field is for the logical agent only).
@@ -84,25 +89,25 @@ const std::vector<KindRules>& kind_rules() {
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::ran_sim, "ran-sim", "ran-sim", "--agent-id", "--id", true, true,
        {{"at", "--at", FieldType::vertex},
-        {"heading", "--heading", FieldType::number},
+        {"heading", "--heading", FieldType::number, -1000, 1000},
         {"loaded", "--loaded", FieldType::flag},
-        {"status_period_ms", "--status-period-ms", FieldType::count},
+        {"status_period_ms", "--status-period-ms", FieldType::count, 1, 60000},
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::routing, "routing", "routing-agent", "--id", "", false, false,
        {{"log_level", "--log-level", FieldType::text}}},
       {AgentKind::logical, "logical", "logical-agent", "--id", "", true, true,
-       {{"lookahead", "--lookahead", FieldType::positive_count},
+       {{"lookahead", "--lookahead", FieldType::count, 1, 1000},
         {"delay_threshold", "--delay-threshold", FieldType::positive_number},
-        {"park_after", "--park-after", FieldType::number},
-        {"charge_below", "--charge-below", FieldType::fraction},
-        {"charge_to", "--charge-to", FieldType::positive_fraction},
+        {"park_after", "--park-after", FieldType::number, -kLargest, kLargest},
+        {"charge_below", "--charge-below", FieldType::number, 0, 1},
+        {"charge_to", "--charge-to", FieldType::positive_number, 0, 1},
         {"error_limit", "--error-limit", FieldType::positive_number},
         {"route_limit", "--route-limit", FieldType::number},
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
-       {{"seed", "--seed", FieldType::count},
+       {{"seed", "--seed", FieldType::count, 0, kLargestWhole},
         {"stations", "--station", FieldType::vertex_list},
-        {"max_orders", "--max-orders", FieldType::count},
+        {"max_orders", "--max-orders", FieldType::count, 0, kLargestWhole},
         {"log_level", "--log-level", FieldType::text}}},
   };
   return rules;
@@ -445,32 +450,32 @@ class LaunchFileParser {
         return;
       }
       case FieldType::number:
-      case FieldType::positive_number:
-        if (!value.is_number() || !std::isfinite(value.get<double>()) ||
-            (rule.type == FieldType::positive_number && value.get<double>() <= 0)) {
-          return checker_.problem(where, rule.type == FieldType::number ? "must be a number"
-                                                                        : "must be a number > 0");
+      case FieldType::positive_number: {
+        const bool positive = rule.type == FieldType::positive_number;
+        const double number = value.is_number() ? value.get<double>() : std::nan("");
+        // NaN fails both comparisons; JSON has no infinities.
+        if (!(positive ? number > 0 : number >= rule.least) || !(number <= rule.most)) {
+          return checker_.problem(where, positive ? fmt::format("must be a number > 0 and at most {}", rule.most)
+                                                  : fmt::format("must be a number from {} to {}", rule.least, rule.most));
         }
-        options.insert(options.end(), {option, format_number(value.get<double>())});
-        return;
-      case FieldType::fraction:
-      case FieldType::positive_fraction: {
-        const bool zero_allowed = rule.type == FieldType::fraction;
-        if (!value.is_number() || !(value.get<double>() >= 0.0 && value.get<double>() <= 1.0) ||
-            (!zero_allowed && value.get<double>() == 0.0)) {
-          return checker_.problem(where, zero_allowed ? "must be a number from 0 to 1"
-                                                      : "must be a number > 0 and at most 1");
-        }
-        options.insert(options.end(), {option, format_number(value.get<double>())});
+        options.insert(options.end(), {option, format_number(number)});
         return;
       }
-      case FieldType::count:
-      case FieldType::positive_count: {
-        const std::int64_t least = rule.type == FieldType::count ? 0 : 1;
-        if (!value.is_number_integer() || value.get<std::int64_t>() < least) {
-          return checker_.problem(where, "must be an integer >= " + std::to_string(least));
+      case FieldType::count: {
+        // Unsigned JSON integers may lie beyond int64: compared as such.
+        const bool whole = value.is_number_integer();
+        const bool in_range =
+            whole && (value.is_number_unsigned()
+                          ? static_cast<double>(value.get<std::uint64_t>()) <= rule.most &&
+                                static_cast<double>(value.get<std::uint64_t>()) >= rule.least
+                          : static_cast<double>(value.get<std::int64_t>()) >= rule.least &&
+                                static_cast<double>(value.get<std::int64_t>()) <= rule.most);
+        if (!in_range) {
+          return checker_.problem(where, fmt::format("must be an integer from {} to {}", rule.least, rule.most));
         }
-        options.insert(options.end(), {option, std::to_string(value.get<std::int64_t>())});
+        options.insert(options.end(), {option, value.is_number_unsigned()
+                                                   ? std::to_string(value.get<std::uint64_t>())
+                                                   : std::to_string(value.get<std::int64_t>())});
         return;
       }
       case FieldType::flag:

@@ -26,8 +26,9 @@ inline constexpr DurationNs kNsPerSecond = 1'000'000'000;
 /// reads Unix time, as a plant's does), so that such a time plus durations of decades never
 /// overflows.
 inline constexpr TimeNs kLatestTime = kForever / 2;
-/// The fastest a shared clock may run, in shared-clock seconds per real second: from an
-/// epoch up to kLatestTime it reads the end of the TimeNs range no sooner than 53 days later.
+/// The fastest a shared clock may run, in shared-clock seconds per real second: from a
+/// reading up to kLatestTime it reaches the end of the TimeNs range no sooner than 53 days
+/// later (create_at_origin refuses a clock that would read beyond kLatestTime at once).
 inline constexpr double kMaxTimeFactor = 1000;
 
 /// Seconds (double) to nanoseconds, rounded to the nearest nanosecond.
@@ -53,8 +54,9 @@ class SharedClock {
   /// the time however late each of them starts (up to their hosts' system clocks): this is
   /// how the launcher gives every agent one clock. The system clock is read once, here;
   /// afterwards the clock follows the steady clock, so it never jumps.
-  /// \return the clock, or invalid_argument as create() says, or when origin_unix_ns is not
-  ///         in [0, kLatestTime].
+  /// \return the clock, or invalid_argument as create() says, when origin_unix_ns is not
+  ///         in [0, kLatestTime], or when the clock would read beyond +-kLatestTime now
+  ///         (an origin long past at a high factor).
   static Result<SharedClock> create_at_origin(TimeNs epoch_ns, double factor, TimeNs origin_unix_ns);
 
   /// A clock with epoch = the Unix time now and factor 1 (a plant).
