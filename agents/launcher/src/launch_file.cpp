@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -46,6 +48,14 @@ struct FieldRule {
 };
 
 constexpr double kLargest = cli::kLargestOptionValue;
+
+/// The value of a JSON integer that int64 holds, else nullopt (a float, or an unsigned
+/// number beyond int64).
+std::optional<std::int64_t> json_integer(const Json& value) {
+  if (!value.is_number_integer()) return std::nullopt;
+  if (value.is_number_unsigned() && value.get<std::uint64_t>() > std::uint64_t{INT64_MAX}) return std::nullopt;
+  return value.get<std::int64_t>();
+}
 constexpr auto kLargestWhole = static_cast<double>(cli::kLargestWholeOption);
 
 /// The fields a vehicle profile may set, and the ran-sim options they become (none: the
@@ -227,10 +237,8 @@ class LaunchFileParser {
       }
     }
     if (auto epoch = root.find("epoch"); epoch != root.end()) {
-      // A number beyond int64 is unsigned (too large) or a float: refused either way.
-      if (epoch->is_number_integer() && !(epoch->is_number_unsigned() && epoch->get<std::uint64_t>() > kLatestTime) &&
-          epoch->get<std::int64_t>() >= 0 && epoch->get<std::int64_t>() <= kLatestTime) {
-        file_.epoch_ns = epoch->get<TimeNs>();
+      if (const auto ns = json_integer(*epoch); ns && *ns >= 0 && *ns <= kLatestTime) {
+        file_.epoch_ns = *ns;
       } else if (!(epoch->is_string() && epoch->get<std::string>() == "now")) {
         checker_.problem("epoch", fmt::format("must be \"now\" or an integer from 0 to {} (shared-clock "
                                               "nanoseconds at start)", kLatestTime));
@@ -462,20 +470,12 @@ class LaunchFileParser {
         return;
       }
       case FieldType::count: {
-        // Unsigned JSON integers may lie beyond int64: compared as such.
-        const bool whole = value.is_number_integer();
-        const bool in_range =
-            whole && (value.is_number_unsigned()
-                          ? static_cast<double>(value.get<std::uint64_t>()) <= rule.most &&
-                                static_cast<double>(value.get<std::uint64_t>()) >= rule.least
-                          : static_cast<double>(value.get<std::int64_t>()) >= rule.least &&
-                                static_cast<double>(value.get<std::int64_t>()) <= rule.most);
-        if (!in_range) {
+        // The bounds are within 2^53, so comparing as doubles is exact.
+        const auto count = json_integer(value);
+        if (!count || static_cast<double>(*count) < rule.least || static_cast<double>(*count) > rule.most) {
           return checker_.problem(where, fmt::format("must be an integer from {} to {}", rule.least, rule.most));
         }
-        options.insert(options.end(), {option, value.is_number_unsigned()
-                                                   ? std::to_string(value.get<std::uint64_t>())
-                                                   : std::to_string(value.get<std::int64_t>())});
+        options.insert(options.end(), {option, std::to_string(*count)});
         return;
       }
       case FieldType::flag:

@@ -54,7 +54,6 @@ int run(const LogicalAgentArguments& arguments) {
     options.vehicle = *vehicle;
   }
   if (options.vehicle.id.empty()) options.vehicle.id = arguments.vehicle_id;
-  if (arguments.charge_to <= 0 || arguments.charge_to > 1) return fail_input("--charge-to must be in (0, 1]");
   options.participant.agent_id = arguments.vehicle_id;
   options.participant.domain_id = arguments.domain_id;
   options.participant.xml_profile_file = arguments.xml_profile;
@@ -120,7 +119,7 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
                       "State of charge under which it charges before new work; 0: never (default 0.2)")
       ->transform(cli::number_in(0.0, 1.0));
   command->add_option("--charge-to", arguments->charge_to, "State of charge a charge aims at, > 0 (default 0.9)")
-      ->transform(cli::number_in(0.0, 1.0));  // and not 0: checked in run()
+      ->transform(cli::positive_at_most(1.0));
   command->add_option("--error-limit", arguments->error_limit,
                       "s a recoverable RAN error may last before the order fails (default 60)")
       ->transform(cli::positive());
