@@ -15,7 +15,8 @@ void add_agents_command(CLI::App& app, CommandContext& context);
 /// `droverctl route FROM TO`: a test or real route from a routing agent, as JSON.
 void add_route_command(CLI::App& app, CommandContext& context);
 
-/// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent.
+/// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent;
+/// `droverctl order withdraw VEHICLE ORDER`: withdraws one.
 void add_order_command(CLI::App& app, CommandContext& context);
 
 /// `droverctl lock ENTITY --from T --until T --reason TEXT`, `droverctl unlock LOCK_ID`,

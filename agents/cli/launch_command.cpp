@@ -90,8 +90,10 @@ void print_summary(const launcher::LaunchFile& file, DurationNs ran_for,
   std::cout << fmt::format("summary of {} ({}): stopped on {} after {:.1f} s simulated\n",
                            file.name.empty() ? file.path.filename().string() : file.name, file.path.string(),
                            outcome.stop_reason, ns_to_seconds(ran_for));
-  std::cout << fmt::format("  orders finished: {}\n  orders failed:   {}\n  orders open:     {}\n",
-                           figures.orders.finished, figures.orders.failed, figures.orders.open);
+  std::cout << fmt::format("  orders finished: {}\n  orders failed:   {}\n", figures.orders.finished,
+                           figures.orders.failed);
+  if (figures.orders.withdrawn > 0) std::cout << fmt::format("  orders withdrawn: {}\n", figures.orders.withdrawn);
+  std::cout << fmt::format("  orders open:     {}\n", figures.orders.open);
   std::cout << fmt::format("  mean lead time:  {}\n", lead_time_text(figures.orders));
   std::cout << fmt::format("  vehicles:        {} reporting, {} RAN statuses, {} topology events\n",
                            figures.vehicles_reporting, figures.statuses, figures.topology_events);

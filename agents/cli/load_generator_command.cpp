@@ -100,8 +100,9 @@ int run(LoadGeneratorArguments arguments) {
                station_count, arguments.domain_id);
   dds::wait_for_shutdown();
   const auto figures = (*generator)->figures();
-  spdlog::info("load generator '{}' stopping: {} orders queued, {} refused, {} finished, {} failed",
-               arguments.agent_id, figures.queued, figures.refused, figures.finished, figures.failed);
+  spdlog::info("load generator '{}' stopping: {} orders queued, {} refused, {} finished, {} failed, {} withdrawn",
+               arguments.agent_id, figures.queued, figures.refused, figures.finished, figures.failed,
+               figures.withdrawn);
   heartbeat->reset();
   generator->reset();
   participant->reset();

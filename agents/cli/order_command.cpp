@@ -4,6 +4,11 @@
 // vehicle's queue; with --wait, also waits for the order to finish or fail. Exit 0: queued
 // (with --wait: finished); 1: refused, failed, or not done within --wait; 2: bad usage (a
 // destination without ':'); 3: no logical agent of that vehicle answered.
+//
+// `droverctl order withdraw VEHICLE ORDER [--reason TEXT] [--wait S]`: withdraws one of the
+// vehicle's orders (drover/logical/withdraw). Exit 0: withdrawn, or being withdrawn (with
+// --wait: withdrawn within S); 1: refused (no such order, it has ended), or it ended
+// otherwise or not within --wait; 3: no logical agent of that vehicle answered.
 
 #include <chrono>
 #include <condition_variable>
@@ -35,13 +40,36 @@ struct OrderArguments {
   double wait_seconds = 0;
 };
 
+struct WithdrawArguments {
+  DdsToolOptions dds;
+  std::string vehicle;
+  std::string order;
+  std::string reason;
+  double wait_seconds = 0;
+};
+
+bool ended(msg::OrderState state) {
+  return state == msg::ORDER_FINISHED || state == msg::ORDER_FAILED || state == msg::ORDER_WITHDRAWN;
+}
+
+/// How an order ended, for messages: "finished", "failed: why", "withdrawn (reason)".
+std::string end_text(const msg::OrderProgress& progress) {
+  switch (progress.state()) {
+    case msg::ORDER_FINISHED: return "finished";
+    case msg::ORDER_FAILED: return "failed: " + progress.failure();
+    case msg::ORDER_WITHDRAWN:
+      return progress.failure().empty() ? "withdrawn" : "withdrawn (" + progress.failure() + ")";
+    default: return "not ended";
+  }
+}
+
 /// Waits for the terminal progress of one order.
 class ProgressWatch {
  public:
   void on_progress(const msg::OrderProgress& progress) {
     std::lock_guard lock(mutex_);
     if (progress.order() != order_) return;
-    if (progress.state() == msg::ORDER_FINISHED || progress.state() == msg::ORDER_FAILED) {
+    if (ended(progress.state())) {
       final_ = progress;
       ended_.notify_all();
     }
@@ -63,6 +91,56 @@ class ProgressWatch {
   std::optional<msg::OrderProgress> final_;
 };
 
+/// A tool participant watching one order's progress (when `wait_seconds` > 0) and a client
+/// of one of the logical agents' services.
+/// Members in the order they are made: destroyed the other way round, the DDS entities go
+/// before their participant and the reader before the watch it calls.
+template <class Request, class Reply>
+struct OrderSession {
+  std::unique_ptr<dds::Participant> participant;
+  ProgressWatch watch;
+  std::unique_ptr<dds::Reader<msg::OrderProgress>> progress;
+  std::unique_ptr<dds::ServiceClient<Request, Reply>> client;
+
+  /// \return kExitOk, or the exit code after printing why it could not be opened.
+  int open(const DdsToolOptions& options, const char* service, const std::string& order, double wait_seconds) {
+    auto opened = open_tool_participant(options);
+    if (!opened) {
+      std::cerr << "error: " << opened.error().message << "\n";
+      return opened.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
+    }
+    participant = std::move(*opened);
+    watch.watch(order);
+    if (wait_seconds > 0) {
+      auto reader = dds::Reader<msg::OrderProgress>::create(
+          *participant, logical_agent::kOrderProgressTopic,
+          [this](const msg::OrderProgress& sample) { watch.on_progress(sample); });
+      if (!reader) {
+        std::cerr << "error: " << reader.error().message << "\n";
+        return kExitFailure;
+      }
+      progress = std::move(*reader);
+    }
+    auto made = dds::ServiceClient<Request, Reply>::create(*participant, logical_agent::kServiceArea, service);
+    if (!made) {
+      std::cerr << "error: " << made.error().message << "\n";
+      return kExitFailure;
+    }
+    client = std::move(*made);
+    return kExitOk;
+  }
+  /// The order's end within `wait_seconds`, if it came.
+  std::optional<msg::OrderProgress> wait_end(double wait_seconds) {
+    return watch.wait(std::chrono::milliseconds(static_cast<std::int64_t>(wait_seconds * 1000)));
+  }
+};
+
+/// The exit code of a service call that got no reply, after printing why.
+int no_reply(const std::string& vehicle, const Error& error) {
+  std::cerr << "error: vehicle '" << vehicle << "': " << error.message << "\n";
+  return error.code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
+}
+
 int send(const OrderArguments& arguments) {
   msg::OrderRequest request;
   request.order(arguments.name.empty()
@@ -79,59 +157,71 @@ int send(const OrderArguments& arguments) {
     destination.operation(text.substr(colon + 1));
     request.destinations().push_back(destination);
   }
-  auto participant = open_tool_participant(arguments.dds);
-  if (!participant) {
-    std::cerr << "error: " << participant.error().message << "\n";
-    return participant.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
+  OrderSession<msg::OrderRequest, msg::OrderReply> session;
+  if (const int code = session.open(arguments.dds, logical_agent::kOrderService, request.order(),
+                                    arguments.wait_seconds);
+      code != kExitOk) {
+    return code;
   }
-  int code = kExitOk;
-  {
-    ProgressWatch watch;
-    watch.watch(request.order());
-    std::unique_ptr<dds::Reader<msg::OrderProgress>> progress;
-    if (arguments.wait_seconds > 0) {
-      auto reader = dds::Reader<msg::OrderProgress>::create(
-          **participant, logical_agent::kOrderProgressTopic,
-          [&watch](const msg::OrderProgress& sample) { watch.on_progress(sample); });
-      if (!reader) {
-        std::cerr << "error: " << reader.error().message << "\n";
-        return kExitFailure;
-      }
-      progress = std::move(*reader);
-    }
-    auto client = dds::ServiceClient<msg::OrderRequest, msg::OrderReply>::create(
-        **participant, logical_agent::kServiceArea, logical_agent::kOrderService);
-    if (!client) {
-      std::cerr << "error: " << client.error().message << "\n";
-      return kExitFailure;
-    }
-    auto reply = (*client)->call(request, arguments.dds.timeout(), arguments.vehicle);
-    if (!reply) {
-      std::cerr << "error: vehicle '" << arguments.vehicle << "': " << reply.error().message << "\n";
-      return reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
-    }
-    if (auto status = dds::from_wire(reply->error()); !status) {
-      std::cerr << "error: vehicle '" << arguments.vehicle << "' refused order '" << request.order()
-                << "': " << status.error().message << "\n";
-      return kExitFailure;
-    }
-    std::cout << "order '" << request.order() << "' queued on '" << arguments.vehicle << "' at position "
-              << reply->queue_position() << "\n";
-    if (progress) {
-      const auto wait = std::chrono::milliseconds(static_cast<std::int64_t>(arguments.wait_seconds * 1000));
-      const auto final_state = watch.wait(wait);
-      if (!final_state) {
-        std::cerr << "error: order '" << request.order() << "' not done within " << arguments.wait_seconds << " s\n";
-        code = kExitFailure;
-      } else if (final_state->state() == msg::ORDER_FAILED) {
-        std::cerr << "error: order '" << request.order() << "' failed: " << final_state->failure() << "\n";
-        code = kExitFailure;
-      } else {
-        std::cout << "order '" << request.order() << "' finished\n";
-      }
-    }
+  auto reply = session.client->call(request, arguments.dds.timeout(), arguments.vehicle);
+  if (!reply) return no_reply(arguments.vehicle, reply.error());
+  if (auto status = dds::from_wire(reply->error()); !status) {
+    std::cerr << "error: vehicle '" << arguments.vehicle << "' refused order '" << request.order()
+              << "': " << status.error().message << "\n";
+    return kExitFailure;
   }
-  return code;
+  std::cout << "order '" << request.order() << "' queued on '" << arguments.vehicle << "' at position "
+            << reply->queue_position() << "\n";
+  if (arguments.wait_seconds <= 0) return kExitOk;
+  const auto final_state = session.wait_end(arguments.wait_seconds);
+  if (!final_state) {
+    std::cerr << "error: order '" << request.order() << "' not done within " << arguments.wait_seconds << " s\n";
+    return kExitFailure;
+  }
+  if (final_state->state() != msg::ORDER_FINISHED) {
+    std::cerr << "error: order '" << request.order() << "' " << end_text(*final_state) << "\n";
+    return kExitFailure;
+  }
+  std::cout << "order '" << request.order() << "' finished\n";
+  return kExitOk;
+}
+
+int withdraw(const WithdrawArguments& arguments) {
+  msg::OrderWithdrawRequest request;
+  request.order(arguments.order);
+  request.reason(arguments.reason);
+  OrderSession<msg::OrderWithdrawRequest, msg::OrderWithdrawReply> session;
+  if (const int code = session.open(arguments.dds, logical_agent::kWithdrawService, arguments.order,
+                                    arguments.wait_seconds);
+      code != kExitOk) {
+    return code;
+  }
+  auto reply = session.client->call(request, arguments.dds.timeout(), arguments.vehicle);
+  if (!reply) return no_reply(arguments.vehicle, reply.error());
+  if (auto status = dds::from_wire(reply->error()); !status) {
+    std::cerr << "error: vehicle '" << arguments.vehicle << "' did not withdraw order '" << arguments.order
+              << "': " << status.error().message << "\n";
+    return kExitFailure;
+  }
+  if (reply->state() == msg::ORDER_WITHDRAWN) {
+    std::cout << "order '" << arguments.order << "' withdrawn\n";
+    return kExitOk;
+  }
+  std::cout << "order '" << arguments.order << "' being withdrawn: vehicle '" << arguments.vehicle
+            << "' stops at the next vertex it can\n";
+  if (arguments.wait_seconds <= 0) return kExitOk;
+  const auto final_state = session.wait_end(arguments.wait_seconds);
+  if (!final_state) {
+    std::cerr << "error: order '" << arguments.order << "' not withdrawn within " << arguments.wait_seconds << " s\n";
+    return kExitFailure;
+  }
+  if (final_state->state() != msg::ORDER_WITHDRAWN) {
+    std::cerr << "error: order '" << arguments.order << "' " << end_text(*final_state)
+              << " before it could be withdrawn\n";
+    return kExitFailure;
+  }
+  std::cout << "order '" << arguments.order << "' withdrawn\n";
+  return kExitOk;
 }
 
 }  // namespace
@@ -152,6 +242,19 @@ void add_order_command(CLI::App& app, CommandContext& context) {
       ->transform(cli::non_negative());
   add_dds_tool_options(*send_command, arguments->dds, 5.0);
   send_command->callback([arguments, &context] { context.exit_code = send(*arguments); });
+
+  auto withdrawal = std::make_shared<WithdrawArguments>();
+  auto* withdraw_command = order->add_subcommand(
+      "withdraw", "Withdraw an order: a queued one at once, a running one once the vehicle stands on a vertex");
+  withdraw_command->add_option("vehicle", withdrawal->vehicle, "The vehicle id")->required();
+  withdraw_command->add_option("order", withdrawal->order, "The order's name")->required();
+  withdraw_command->add_option("--reason", withdrawal->reason, "Why (shown in the order's progress)");
+  withdraw_command->add_option("--wait", withdrawal->wait_seconds,
+                               "Also wait up to S seconds until a running order is withdrawn (exit 1 if it ends "
+                               "otherwise)")
+      ->transform(cli::non_negative());
+  add_dds_tool_options(*withdraw_command, withdrawal->dds, 5.0);
+  withdraw_command->callback([withdrawal, &context] { context.exit_code = withdraw(*withdrawal); });
 }
 
 }  // namespace drover::cli

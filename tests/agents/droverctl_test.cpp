@@ -96,6 +96,16 @@ TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 2);
   EXPECT_NE(err.find("--timeout"), std::string::npos) << err;
+
+  status = run_droverctl({"order", "withdraw", "V1"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("order is required"), std::string::npos) << err;
+
+  status = run_droverctl({"order", "withdraw", "V1", "o1", "--wait", "-3"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("--wait"), std::string::npos) << err;
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 83..93. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 83..93 and 99. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -373,7 +373,10 @@ class FleetTest : public ::testing::Test {
         [&] {
           auto found = seen_.orders.find(name);
           if (found == seen_.orders.end()) return false;
-          if (found->second.state() != msg::ORDER_FINISHED && found->second.state() != msg::ORDER_FAILED) return false;
+          const auto state = found->second.state();
+          if (state != msg::ORDER_FINISHED && state != msg::ORDER_FAILED && state != msg::ORDER_WITHDRAWN) {
+            return false;
+          }
           out = found->second;
           return true;
         },
@@ -776,6 +779,81 @@ TEST_F(FleetTest, StoppedLogicalAgentStopsItsVehicleAndCancelsItsRouteAhead) {
   std::lock_guard lock(seen_.mutex);
   EXPECT_LT(seen_.latest["V1"].pose.y, 6.0) << "V1 drove on after its agent stopped";
   for (const auto* ahead : {"bar-2", "right-4"}) EXPECT_NE(seen_.holders[ahead], "V1") << ahead;
+}
+
+/// Runs droverctl to its end. \return its exit code (-1 if it did not end); output in out/err.
+int droverctl(const Fleet& fleet, const std::string& name, const std::vector<std::string>& args, std::string& out,
+              std::string& err) {
+  const std::string stem = (fleet.dir() / ("droverctl-" + name)).string();
+  auto child = ChildProcess::spawn(binary_path("droverctl"), args, stem + ".out", stem + ".err");
+  if (!child) return -1;
+  auto status = child->wait_exit(kRunTimeout);
+  out = read_file(stem + ".out");
+  err = read_file(stem + ".err");
+  return status && status->exited ? status->code : -1;
+}
+
+TEST_F(FleetTest, WithdrawnOrdersEndAQueuedOneAtOnceARunningOneOnAVertexAndTheVehicleWorksOn) {
+  constexpr std::uint32_t kDomain = 99;
+  const std::string domain = std::to_string(kDomain);
+  Fleet fleet(kDomain, "withdraw");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-running"));
+  ASSERT_EQ(send_order("V1", "v1-queued", {{"left-4", "NOP"}}), "");
+  // A stall (shorter than the error limit) keeps V1 from arriving while droverctl works: the
+  // running order is still running when its withdrawal comes.
+  ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::stall, seconds_to_ns(30), 10s));
+
+  std::string out, err;
+  EXPECT_EQ(droverctl(fleet, "queued", {"order", "withdraw", "V1", "v1-queued", "--reason", "not needed", "--domain", domain},
+                      out, err), 0) << err;
+  EXPECT_NE(out.find("order 'v1-queued' withdrawn"), std::string::npos) << out;
+  const auto queued = wait_order("v1-queued");
+  ASSERT_TRUE(queued.has_value());
+  EXPECT_EQ(queued->state(), msg::ORDER_WITHDRAWN);
+  EXPECT_EQ(queued->failure(), "not needed");
+  EXPECT_FALSE(queued->started().present()) << "a withdrawn queued order never starts";
+
+  EXPECT_EQ(droverctl(fleet, "running", {"order", "withdraw", "V1", "v1-running", "--reason", "aisle closed", "--wait",
+                                         "200", "--domain", domain}, out, err), 0) << err;
+  EXPECT_NE(out.find("being withdrawn"), std::string::npos) << out;
+  const auto running = wait_order("v1-running");
+  ASSERT_TRUE(running.has_value());
+  EXPECT_EQ(running->state(), msg::ORDER_WITHDRAWN) << running->failure();
+  EXPECT_EQ(running->failure(), "aisle closed");
+  EXPECT_TRUE(seen_.wait(
+      [&] { return std::find(seen_.cancelled.begin(), seen_.cancelled.end(), "V1") != seen_.cancelled.end(); }, 60s))
+      << "V1's route ahead was not cancelled";
+  // It stopped short of its destination, standing on a vertex that it holds again, not on
+  // an edge.
+  const auto on_held_vertex = [&] {
+    const auto& status = seen_.latest["V1"];
+    const topology::Point position(status.pose.x, status.pose.y);
+    for (topology::EntityIndex v = 0; v < world_->vertex_count(); ++v) {
+      if (seen_.holders[world_->id(v)] == "V1" && status.linear_speed == 0.0 &&
+          bg::distance(position, world_->vertex(v).position) < 0.05) {
+        return world_->id(v) != "right-4";
+      }
+    }
+    return false;
+  };
+  EXPECT_TRUE(seen_.wait(on_held_vertex, 60s)) << "V1 does not stand still on a vertex it holds, short of right-4";
+
+  // An ended order cannot be withdrawn again, an unknown one not at all.
+  EXPECT_EQ(droverctl(fleet, "again", {"order", "withdraw", "V1", "v1-running", "--domain", domain}, out, err), 1);
+  EXPECT_NE(err.find("has ended already (withdrawn)"), std::string::npos) << err;
+  EXPECT_EQ(droverctl(fleet, "unknown", {"order", "withdraw", "V1", "no-such-order", "--domain", domain}, out, err), 1);
+  EXPECT_NE(err.find("no order 'no-such-order'"), std::string::npos) << err;
+
+  // The vehicle takes new work from where it stopped.
+  ASSERT_EQ(send_order("V1", "v1-after", {{"right-4", "NOP"}}), "");
+  const auto after = wait_order("v1-after");
+  ASSERT_TRUE(after.has_value());
+  EXPECT_EQ(after->state(), msg::ORDER_FINISHED) << after->failure();
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
 }
 
 }  // namespace

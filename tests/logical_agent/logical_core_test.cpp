@@ -112,6 +112,51 @@ TEST(OrderBook, RunsOrdersInArrivalOrderThroughEveryDestination) {
                                             "a:finished:2", "b:running:0", "b:failed:0"}));
 }
 
+TEST(OrderBook, WithdrawsAQueuedOrderAtOnceAndARunningOneWhenTheExecutorEndsIt) {
+  const auto world = h_crossing();
+  std::vector<std::string> seen;
+  OrderBook book([&](const Order& order) {
+    seen.push_back(order.name + ":" + to_string(order.state) + ":" + order.failure);
+  });
+  for (const char* name : {"a", "b", "c"}) {
+    auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}, {"right-4", "NOP", {}}}, {}});
+    ASSERT_TRUE(order);
+    ASSERT_TRUE(book.add(*order, 10));
+  }
+  ASSERT_EQ(book.start_next(20)->name, "a");
+
+  // Queued: withdrawn at once, never started.
+  EXPECT_EQ(book.withdraw("b", "wrong pallet", 30).value(), OrderState::withdrawn);
+  EXPECT_EQ(book.find("b")->finished, 30);
+  EXPECT_FALSE(book.find("b")->started);
+  EXPECT_EQ(book.queued_count(), 1u);
+  // Running: only marked; the first reason stays.
+  EXPECT_FALSE(book.withdrawal_pending());
+  EXPECT_EQ(book.withdraw("a", "line stopped", 40).value(), OrderState::running);
+  EXPECT_EQ(book.withdraw("a", "again", 41).value(), OrderState::running);
+  EXPECT_TRUE(book.withdrawal_pending());
+  EXPECT_EQ(book.find("a")->state, OrderState::running);
+  book.end_withdrawn(50);
+  EXPECT_EQ(book.find("a")->state, OrderState::withdrawn);
+  EXPECT_EQ(book.find("a")->finished, 50);
+  EXPECT_FALSE(book.withdrawal_pending());
+  // The next order runs as usual.
+  EXPECT_EQ(book.start_next(60)->name, "c");
+  EXPECT_FALSE(book.withdrawal_pending());
+
+  // Ended or unknown orders are refused, and nothing changes.
+  const auto ended = book.withdraw("a", "late", 70);
+  ASSERT_FALSE(ended);
+  EXPECT_EQ(ended.error().code, ErrorCode::conflict);
+  EXPECT_NE(ended.error().message.find("withdrawn"), std::string::npos) << ended.error().message;
+  const auto unknown = book.withdraw("zz", "", 70);
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error().code, ErrorCode::not_found);
+  EXPECT_EQ(seen, (std::vector<std::string>{"a:queued:", "b:queued:", "c:queued:", "a:running:",
+                                            "b:withdrawn:wrong pallet", "a:withdrawn:line stopped",
+                                            "c:running:"}));
+}
+
 TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_FALSE(operation_action(Destination{0, "x", "NOP", {}}));
   EXPECT_FALSE(operation_action(Destination{0, "x", "", {}}));

@@ -39,6 +39,7 @@ const char* order_state_name(msg::OrderState state) {
     case msg::ORDER_RUNNING: return "running";
     case msg::ORDER_FINISHED: return "finished";
     case msg::ORDER_FAILED: return "failed";
+    case msg::ORDER_WITHDRAWN: return "withdrawn";
   }
   return "unknown";
 }
@@ -140,6 +141,7 @@ void FleetMonitor::on_progress(const msg::OrderProgress& progress) {
   OrderOutcome outcome = OrderOutcome::open;
   if (progress.state() == msg::ORDER_FINISHED) outcome = OrderOutcome::finished;
   if (progress.state() == msg::ORDER_FAILED) outcome = OrderOutcome::failed;
+  if (progress.state() == msg::ORDER_WITHDRAWN) outcome = OrderOutcome::withdrawn;
   if (trace_ != nullptr) trace_->write(progress_time(progress), "order", order_line(progress));
   std::lock_guard lock(mutex_);
   orders_.update(progress.order(), outcome, time_of(progress.created()), time_of(progress.finished()));

@@ -78,17 +78,23 @@ void LoadGenerator::on_vehicle(const msg::VehicleState& state) {
 }
 
 void LoadGenerator::on_progress(const msg::OrderProgress& progress) {
-  if (progress.state() != msg::ORDER_FINISHED && progress.state() != msg::ORDER_FAILED) return;
+  const bool ended = progress.state() == msg::ORDER_FINISHED || progress.state() == msg::ORDER_FAILED ||
+                     progress.state() == msg::ORDER_WITHDRAWN;
+  if (!ended) return;
   std::string vehicle;
   {
     std::lock_guard lock(mutex_);
     const auto ours = outstanding_.find(progress.vehicle());
     if (ours == outstanding_.end() || ours->second != progress.order()) return;
     outstanding_.erase(ours);
-    (progress.state() == msg::ORDER_FINISHED ? figures_.finished : figures_.failed) += 1;
+    switch (progress.state()) {
+      case msg::ORDER_FINISHED: ++figures_.finished; break;
+      case msg::ORDER_WITHDRAWN: ++figures_.withdrawn; break;
+      default: ++figures_.failed; break;
+    }
     vehicle = progress.vehicle();
-    // Destination 0 loads; failing after it leaves the load on the vehicle.
-    if (progress.state() == msg::ORDER_FAILED && progress.destination() >= 1) {
+    // Destination 0 loads; ending after it unfinished leaves the load on the vehicle.
+    if (progress.state() != msg::ORDER_FINISHED && progress.destination() >= 1) {
       may_carry_.insert(vehicle);
     } else if (progress.state() == msg::ORDER_FINISHED) {
       may_carry_.erase(vehicle);

@@ -18,6 +18,7 @@ OrderFigures OrderTally::figures() const {
     switch (entry.outcome) {
       case OrderOutcome::open: ++figures.open; break;
       case OrderOutcome::failed: ++figures.failed; break;
+      case OrderOutcome::withdrawn: ++figures.withdrawn; break;
       case OrderOutcome::finished:
         ++figures.finished;
         if (entry.lead_time) {

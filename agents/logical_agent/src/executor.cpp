@@ -139,7 +139,7 @@ bool LogicalAgent::hold_position() {
     return false;
   }
   vertex_ = vertex;
-  auto route = plan_route(*vertex, 0);
+  auto route = plan_route(*vertex, 0, false);
   if (!route) {
     spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), route.error().message);
     return false;
@@ -169,11 +169,12 @@ bool LogicalAgent::drivable(const std::vector<topology::RouteStep>& steps) const
   return true;
 }
 
-Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, DurationNs patience) {
+Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order) {
   const TimeNs give_up = clock_.now() + patience;
   bool warned = false;
   for (;;) {
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
+    if (for_order && order_withdrawn()) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
     topology::RouteId id = 0;
     while (id == 0) id = route_ids_();
     msg::RouteRequest request;
@@ -295,7 +296,7 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
   for (;;) {
     if (route_ && route_->arrived() && vertex_ == goal) return {};
     set_activity(activity);
-    auto route = plan_route(goal, patience);
+    auto route = plan_route(goal, patience, activity == Activity::driving);
     if (!route) {
       // Stranded half-way (a re-plan found nothing): the rest of the old route must not
       // keep blocking others.
@@ -314,6 +315,10 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
       case FollowResult::failed:
         abandon_route();
         return fail(ErrorCode::unavailable, failure);
+      case FollowResult::withdrawn:
+        // The vehicle stands on the vertex its last move reached: the rest of the route goes.
+        abandon_route();
+        return fail(ErrorCode::not_permitted, "the order is being withdrawn");
     }
   }
 }
@@ -374,8 +379,12 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
       }
     }
     if (route_->arrived() && pending_moves_.empty()) return FollowResult::arrived;
-    if (replan) {
-      if (pending_moves_.empty()) return FollowResult::replan;
+    // A withdrawal, like a re-plan, allocates nothing more: the vehicle drives the moves it
+    // was given (at most the look-ahead) and stands on a vertex, never part-way along an
+    // edge as a cancel would leave it.
+    const bool withdrawn = drive_activity_ == Activity::driving && order_withdrawn();
+    if (replan || withdrawn) {
+      if (pending_moves_.empty()) return withdrawn ? FollowResult::withdrawn : FollowResult::replan;
     } else {
       // Allocation ahead, in route order, within the look-ahead.
       while (auto next = route_->next_to_allocate(route_->position_step(), options_.lookahead)) {
@@ -618,18 +627,37 @@ Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activ
   }
 }
 
+bool LogicalAgent::order_withdrawn() {
+  std::lock_guard lock(mutex_);
+  return book_.withdrawal_pending();
+}
+
 void LogicalAgent::execute_order() {
+  // A withdrawal ends the order between its steps: before a drive, after it (the operation
+  // is skipped), or after an operation (which is completed, not cut short) when more
+  // destinations follow; a drive under way stops at the next vertex it can (drive_to).
+  const auto end_if_withdrawn = [this](const std::string& name) {
+    std::lock_guard lock(mutex_);
+    if (!book_.withdrawal_pending()) return false;
+    book_.end_withdrawn(clock_.now());
+    spdlog::info("order '{}' withdrawn", name);
+    return true;
+  };
   for (;;) {
     Destination destination;
     std::string name;
+    bool last = false;
     {
       std::lock_guard lock(mutex_);
       const Order* order = book_.current();
       if (order == nullptr) return;
       destination = order->destinations[order->destination];
       name = order->name;
+      last = order->destination + 1 == order->destinations.size();
     }
+    if (end_if_withdrawn(name)) return;
     Status done = drive_to(destination.location, Activity::driving, options_.route_limit);
+    if (end_if_withdrawn(name)) return;
     if (done) {
       if (auto action = operation_action(destination)) {
         const bool charge = action->kind == ran::ActionKind::charge;
@@ -637,6 +665,7 @@ void LogicalAgent::execute_order() {
         done = operate(*action, charge ? Activity::charging : Activity::operating);
       }
     }
+    if (done && !last && end_if_withdrawn(name)) return;
     if (!done) {
       if (!stopping_) {
         raise_alarm(msg::ALARM_ERROR, "order '" + name + "' of vehicle '" + vehicle_id() + "' failed: " + done.error().message);

@@ -31,6 +31,7 @@ msg::OrderState to_wire(OrderState state) {
     case OrderState::running: return msg::ORDER_RUNNING;
     case OrderState::finished: return msg::ORDER_FINISHED;
     case OrderState::failed: return msg::ORDER_FAILED;
+    case OrderState::withdrawn: return msg::ORDER_WITHDRAWN;
   }
   return msg::ORDER_FAILED;
 }
@@ -110,6 +111,13 @@ Status LogicalAgent::start() {
       });
   if (!server) return unexpected(server.error());
   order_server_ = std::move(*server);
+  auto withdraw = dds::ServiceServer<msg::OrderWithdrawRequest, msg::OrderWithdrawReply>::create(
+      *participant_, kServiceArea, kWithdrawService,
+      [this](const msg::OrderWithdrawRequest& request, dds::ReplyHandle<msg::OrderWithdrawReply> reply) {
+        on_withdraw(request, std::move(reply));
+      });
+  if (!withdraw) return unexpected(withdraw.error());
+  withdraw_server_ = std::move(*withdraw);
 
   executor_ = std::thread([this] { run(); });
   return {};
@@ -122,6 +130,7 @@ LogicalAgent::~LogicalAgent() {
   }
   wake_.notify_all();
   if (executor_.joinable()) executor_.join();
+  withdraw_server_.reset();
   order_server_.reset();
   make_way_reader_.reset();
   notice_reader_.reset();
@@ -180,6 +189,34 @@ void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<m
   }
   spdlog::info("order '{}' queued at position {}", spec.name, *position);
   answer.queue_position(static_cast<std::uint32_t>(*position));
+  if (auto sent = reply.send(std::move(answer)); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+}
+
+void LogicalAgent::on_withdraw(const msg::OrderWithdrawRequest& request,
+                               dds::ReplyHandle<msg::OrderWithdrawReply> reply) {
+  msg::OrderWithdrawReply answer;
+  Result<OrderState> state = OrderState::queued;
+  if (request.header().responder().empty()) {
+    // As for orders: every logical agent sees an unaddressed request.
+    state = fail(ErrorCode::invalid_argument,
+                 "withdraw '" + request.order() + "': header.responder must name the vehicle of the order");
+  } else {
+    {
+      std::lock_guard lock(mutex_);
+      state = book_.withdraw(request.order(), request.reason(), clock_.now());
+      if (const Order* order = book_.find(request.order())) answer.state(to_wire(order->state));
+      ++events_;
+    }
+    wake_.notify_all();
+  }
+  if (!state) {
+    spdlog::warn("withdrawal refused: {}", state.error().message);
+    answer.error(dds::to_wire(state.error()));
+  } else {
+    spdlog::info("order '{}' {} ({})", request.order(),
+                 *state == OrderState::withdrawn ? "withdrawn" : "being withdrawn",
+                 request.reason().empty() ? "no reason given" : request.reason());
+  }
   if (auto sent = reply.send(std::move(answer)); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
 }
 

@@ -90,8 +90,9 @@ class LogicalAgent {
 
  private:
   enum class Activity { idle, driving, operating, parking, charging, waiting, error };
-  /// How following a route ended.
-  enum class FollowResult { arrived, replan, failed };
+  /// How following a route ended (withdrawn: the running order is being withdrawn and the
+  /// vehicle stands where its commanded moves took it).
+  enum class FollowResult { arrived, replan, failed, withdrawn };
 
   LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options);
   Status start();
@@ -101,6 +102,7 @@ class LogicalAgent {
 
   // ---- DDS callbacks (record and wake) ----
   void on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply);
+  void on_withdraw(const msg::OrderWithdrawRequest& request, dds::ReplyHandle<msg::OrderWithdrawReply> reply);
   void on_notice(const msg::ReservationNotice& notice);
   void on_make_way(const msg::MakeWayRequest& request);
   void on_status(const ran::VehicleStatus& status);
@@ -119,7 +121,9 @@ class LogicalAgent {
   /// it is blocked. \return the route or why none.
   /// \param patience  how long (shared clock) to keep trying while the timelines or locks
   ///                  leave no route; 0: one try.
-  Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience);
+  /// \param for_order  the route serves the running order: waiting for one ends (an error)
+  ///                  once the order is being withdrawn.
+  Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order);
   /// Whether `steps` alternate vertex, edge, vertex, ... with each edge drivable from the
   /// vertex before it to the vertex after it (what RouteTracker relies on).
   bool drivable(const std::vector<topology::RouteStep>& steps) const;
@@ -127,11 +131,15 @@ class LogicalAgent {
   /// the previous route.
   Status switch_route(RouteTracker next);
   /// Drives to `goal` (re-planning on locks). \return success, or why it failed.
+  /// Activity::driving drives for the running order: a withdrawal of the order stops it
+  /// (not_permitted) where the vehicle stands once its commanded moves are done.
   Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience);
   FollowResult follow(std::string& failure);
   /// Performs an action where the vehicle stands. \return success or why it failed.
   Status operate(const ran::ActionCommand& action, Activity activity);
   void execute_order();
+  /// Whether the running order is being withdrawn.
+  bool order_withdrawn();
   /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
   void go_to_service_vertex(topology::VertexKind kind);
   /// Drives to the nearest vertex of `kind` other than the one the vehicle stands on (or,
@@ -220,6 +228,7 @@ class LogicalAgent {
   std::unique_ptr<dds::Reader<msg::ReservationNotice>> notice_reader_;
   std::unique_ptr<dds::Reader<msg::MakeWayRequest>> make_way_reader_;
   std::unique_ptr<dds::ServiceServer<msg::OrderRequest, msg::OrderReply>> order_server_;
+  std::unique_ptr<dds::ServiceServer<msg::OrderWithdrawRequest, msg::OrderWithdrawReply>> withdraw_server_;
   std::thread executor_;
 };
 

@@ -10,6 +10,7 @@ const char* to_string(OrderState state) noexcept {
     case OrderState::running: return "running";
     case OrderState::finished: return "finished";
     case OrderState::failed: return "failed";
+    case OrderState::withdrawn: return "withdrawn";
   }
   return "unknown";
 }
@@ -104,6 +105,44 @@ void OrderBook::fail_current(const std::string& reason, TimeNs now) {
   order->state = OrderState::failed;
   order->finished = now;
   order->failure = reason;
+  publish(*order);
+}
+
+Result<OrderState> OrderBook::withdraw(const std::string& name, const std::string& reason, TimeNs now) {
+  const auto found = std::find_if(orders_.begin(), orders_.end(), [&](const Order& o) { return o.name == name; });
+  if (found == orders_.end()) return fail(ErrorCode::not_found, "no order '" + name + "'");
+  Order& order = *found;
+  switch (order.state) {
+    case OrderState::queued:
+      order.state = OrderState::withdrawn;
+      order.finished = now;
+      order.failure = reason;
+      publish(order);
+      break;
+    case OrderState::running:
+      if (!order.withdrawal) order.withdrawal = reason;
+      break;
+    case OrderState::finished:
+    case OrderState::failed:
+    case OrderState::withdrawn:
+      return fail(ErrorCode::conflict,
+                  "order '" + name + "' has ended already (" + to_string(order.state) + ")");
+  }
+  return order.state;
+}
+
+bool OrderBook::withdrawal_pending() const {
+  const Order* order = current();
+  return order != nullptr && order->withdrawal.has_value();
+}
+
+void OrderBook::end_withdrawn(TimeNs now) {
+  Order* order = running();
+  if (order == nullptr) return;
+  order->state = OrderState::withdrawn;
+  order->finished = now;
+  order->failure = order->withdrawal.value_or("");
+  order->withdrawal.reset();
   publish(*order);
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The order queue of one logical agent (no DDS): orders are validated against the topology
-// when they arrive, executed one at a time in arrival order, each destination in turn, and
-// every change of an order is reported to an observer (the agent publishes it).
+// when they arrive, executed one at a time in arrival order, each destination in turn, may
+// be withdrawn, and every change of an order is reported to an observer (the agent
+// publishes it).
 
 #include <cstddef>
 #include <deque>
@@ -26,7 +27,7 @@ struct Destination {
   std::map<std::string, std::string> properties;
 };
 
-enum class OrderState { queued, running, finished, failed };
+enum class OrderState { queued, running, finished, failed, withdrawn };
 const char* to_string(OrderState state) noexcept;
 
 struct Order {
@@ -38,7 +39,9 @@ struct Order {
   TimeNs created = 0;
   std::optional<TimeNs> started;
   std::optional<TimeNs> finished;
-  std::string failure;
+  std::string failure;  ///< failed: why; withdrawn: the reason given
+  /// Running, to be withdrawn (the executor ends it once the vehicle stands): the reason.
+  std::optional<std::string> withdrawal;
 };
 
 /// The RAN action an operation asks for at its location; nullopt when it asks for none
@@ -83,6 +86,17 @@ class OrderBook {
   bool advance(TimeNs now);
   /// Fails the running order with `reason` at `now` (no-op when none runs).
   void fail_current(const std::string& reason, TimeNs now);
+
+  /// Withdraws order `name` for `reason`: a queued one ends withdrawn at `now`; a running
+  /// one is only marked (its `withdrawal` set, nothing published), and the executor ends it
+  /// with end_withdrawn once the vehicle stands. Withdrawing a running order again is no
+  /// change. \return the order's state after the call; not_found when no order has that
+  /// name, conflict when it has ended (nothing changes on error).
+  Result<OrderState> withdraw(const std::string& name, const std::string& reason, TimeNs now);
+  /// Whether the running order is to be withdrawn.
+  bool withdrawal_pending() const;
+  /// Ends the running order as withdrawn at `now` (no-op when none runs).
+  void end_withdrawn(TimeNs now);
 
   /// Orders waiting behind the running one.
   std::size_t queued_count() const;

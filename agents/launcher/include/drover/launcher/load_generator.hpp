@@ -44,6 +44,7 @@ struct LoadFigures {
   std::uint64_t refused = 0;   ///< orders refused or not answered
   std::uint64_t finished = 0;  ///< of ours, finished
   std::uint64_t failed = 0;    ///< of ours, failed
+  std::uint64_t withdrawn = 0;  ///< of ours, withdrawn (by an operator)
 };
 
 /// Thread-safe. Must be destroyed before its Participant.

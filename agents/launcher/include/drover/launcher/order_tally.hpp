@@ -1,6 +1,7 @@
 #pragma once
 // Counts the orders of a run from their progress (drover/logical/order_progress): how many
-// finished and failed, and their mean lead time (finished - created on the shared clock).
+// finished, failed and were withdrawn, and their mean lead time (finished - created on the
+// shared clock).
 
 #include <cstdint>
 #include <map>
@@ -11,12 +12,13 @@
 
 namespace drover::launcher {
 
-enum class OrderOutcome { open, finished, failed };
+enum class OrderOutcome { open, finished, failed, withdrawn };
 
 struct OrderFigures {
   std::uint64_t open = 0;
   std::uint64_t finished = 0;
   std::uint64_t failed = 0;
+  std::uint64_t withdrawn = 0;
   /// Mean of finished - created over the finished orders that carry both times.
   std::optional<double> mean_lead_time_s;
 };

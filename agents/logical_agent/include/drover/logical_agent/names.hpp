@@ -8,6 +8,9 @@ namespace drover::logical_agent {
 /// one logical agent through header.responder.
 inline constexpr const char* kServiceArea = "logical";
 inline constexpr const char* kOrderService = "order";
+/// Service drover/logical/withdraw/{request,reply}: OrderWithdrawRequest / OrderWithdrawReply,
+/// addressed like an order.
+inline constexpr const char* kWithdrawService = "withdraw";
 /// State topic of OrderProgress, keyed on the order name.
 inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progress";
 /// State topic of VehicleState, keyed on the vehicle id.
