@@ -1,5 +1,7 @@
 #include "drover/ran_runner/wire.hpp"
 
+#include <boost/geometry/algorithms/correct.hpp>
+#include <boost/geometry/algorithms/is_valid.hpp>
 #include <fmt/format.h>
 
 namespace drover::ran {
@@ -17,9 +19,14 @@ msg::RanPolygon polygon_to_wire(const topology::Polygon& polygon) {
   return wire;
 }
 
+/// Either winding and an open or closed ring are taken (ROS lists outlines counter-clockwise,
+/// Boost.Geometry wants them clockwise and closed): corrected here, since an area computed
+/// from the other winding is negative, and every footprint would seem to lie inside any
+/// allocated area.
 topology::Polygon polygon_from_wire(const msg::RanPolygon& wire) {
   topology::Polygon polygon;
   for (const auto& point : wire.ring()) polygon.outer().emplace_back(point.x(), point.y());
+  boost::geometry::correct(polygon);
   return polygon;
 }
 
@@ -165,6 +172,12 @@ Result<VehicleStatus> from_wire(const msg::RanStatus& wire) {
     status.errors.push_back({*level, error.code(), error.text()});
   }
   status.footprint = polygon_from_wire(wire.footprint());
+  // The logical agent checks the footprint against what it allocated and releases what it
+  // no longer touches: an empty or self-crossing one would pass both checks unseen.
+  if (std::string why; !boost::geometry::is_valid(status.footprint, why)) {
+    return fail(ErrorCode::invalid_argument,
+                fmt::format("status of '{}': the footprint is not a valid polygon ({})", wire.vehicle_id(), why));
+  }
   return status;
 }
 
