@@ -174,6 +174,21 @@ TEST(LaunchFile, ChargingToZeroIsRefused) {
   EXPECT_EQ(text.find("charge_below"), std::string::npos) << "0 means never: " << text;
 }
 
+// A charge that ends at or under the threshold that starts one would be followed by another
+// for ever: refused, against the default of a field left out too.
+TEST(LaunchFile, ChargingToNoMoreThanTheThresholdIsRefused) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
+      {"kind": "ran-sim", "vehicle": "V2", "at": "north-east"},
+      {"kind": "logical", "vehicle": "V1", "charge_below": 0.95},
+      {"kind": "logical", "vehicle": "V2", "charge_below": 0.5, "charge_to": 0.5})"));
+  EXPECT_NE(text.find("agents[4].charge_to: the state of charge a charge aims at (0.9) must be above the one "
+                      "under which the vehicle charges (0.95)"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("agents[5].charge_to: the state of charge a charge aims at (0.5) must be above"),
+            std::string::npos) << text;
+}
+
 TEST(LaunchFile, VerticesPartitionsAndProfilesMustExist) {
   const auto text = problems_of(loop_file(R"({"kind": "topology", "partition": "north"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "nowhere", "profile": "fast"},

@@ -16,6 +16,7 @@
 #include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
+#include "drover/logical_agent/charging.hpp"
 #include "drover/topology/topology_file.hpp"
 
 namespace drover::launcher {
@@ -372,6 +373,7 @@ class LaunchFileParser {
     if (rules->kind == AgentKind::ran_sim && !entry.contains("at")) {
       checker_.problem(join(where, "at"), "missing: the vertex the vehicle starts at");
     }
+    if (rules->kind == AgentKind::logical) check_charging(entry, where);
     if (rules->kind == AgentKind::logical && !agent.id.empty() && agent.id != agent.vehicle) {
       checker_.problem(join(where, "id"), "a logical agent's id is its vehicle id: leave it out");
     }
@@ -399,6 +401,18 @@ class LaunchFileParser {
                               ? entry["partition"].get<std::string>()
                               : "");
     file_.agents.push_back(std::move(agent));
+  }
+
+  /// A logical agent's charging thresholds together, once each is in range (its rule says
+  /// what is wrong otherwise).
+  void check_charging(const Json& entry, const std::string& where) {
+    const auto number_or = [&entry](const char* key, double otherwise) {
+      return entry.contains(key) && entry[key].is_number() ? entry[key].get<double>() : otherwise;
+    };
+    const double below = number_or("charge_below", logical_agent::kDefaultChargeBelow);
+    const double to = number_or("charge_to", logical_agent::kDefaultChargeTo);
+    if (!(below >= 0 && below <= 1 && to > 0 && to <= 1)) return;
+    if (auto problem = logical_agent::charging_problem(below, to)) checker_.problem(join(where, "charge_to"), *problem);
   }
 
   static std::string default_id(const KindRules& rules, const AgentEntry& agent, const Json& entry) {

@@ -12,6 +12,7 @@
 #include "drover/carp/vehicle_profile_json.hpp"
 #include "drover/common/logging.hpp"
 #include "drover/dds/shutdown_signal.hpp"
+#include "drover/logical_agent/charging.hpp"
 #include "drover/topology/topology_file.hpp"
 
 namespace drover::cli {
@@ -30,8 +31,8 @@ struct LogicalAgentArguments {
   std::size_t lookahead = 2;
   double delay_threshold = 2;
   double park_after = 30;
-  double charge_below = 0.2;
-  double charge_to = 0.9;
+  double charge_below = logical_agent::kDefaultChargeBelow;
+  double charge_to = logical_agent::kDefaultChargeTo;
   double error_limit = 60;
   double route_limit = 120;
 };
@@ -42,6 +43,9 @@ int fail_input(const std::string& message) {
 }
 
 int run(const LogicalAgentArguments& arguments) {
+  if (auto problem = logical_agent::charging_problem(arguments.charge_below, arguments.charge_to)) {
+    return fail_input("--charge-to: " + *problem);
+  }
   make_agent_logger(arguments.vehicle_id, arguments.log_level);
   auto loaded = topology::load_topology_file(arguments.topology_file);
   if (!loaded) {

@@ -719,6 +719,14 @@ void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
     if (auto charged = operate(charge, Activity::charging); !charged) {
       charge_retry_at_ = clock_.now() + kChargeRetry;
       raise_alarm(msg::ALARM_WARNING, "vehicle '" + vehicle_id() + "' could not charge: " + charged.error().message);
+    } else if (const auto status = latest_status();
+               status && status->battery.state_of_charge < options_.charge_below) {
+      // The charge ended where another would start at once (a charger that does not
+      // deliver): not again before the retry time, so that orders run meanwhile.
+      charge_retry_at_ = clock_.now() + kChargeRetry;
+      raise_alarm(msg::ALARM_WARNING,
+                  fmt::format("vehicle '{}' charged to {:.2f} only, under the threshold {:.2f}", vehicle_id(),
+                              status->battery.state_of_charge, options_.charge_below));
     }
   }
 }

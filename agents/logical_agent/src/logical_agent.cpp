@@ -54,6 +54,9 @@ Result<std::unique_ptr<LogicalAgent>> LogicalAgent::create(std::shared_ptr<const
     return fail(ErrorCode::invalid_argument, "vehicle profile: " + valid.error().message);
   }
   if (options.lookahead == 0) return fail(ErrorCode::invalid_argument, "lookahead must be at least 1 vertex");
+  if (auto problem = charging_problem(options.charge_below, options.charge_to)) {
+    return fail(ErrorCode::invalid_argument, "charge_to: " + *problem);
+  }
   if (options.vehicle.id.empty()) options.vehicle.id = options.participant.agent_id;
   std::unique_ptr<LogicalAgent> agent(new LogicalAgent(std::move(topology), clock, std::move(options)));
   if (auto started = agent->start(); !started) return unexpected(started.error());

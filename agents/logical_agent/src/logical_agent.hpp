@@ -37,6 +37,7 @@
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_server.hpp"
 #include "drover/dds/writer.hpp"
+#include "drover/logical_agent/charging.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/ran_runner/client.hpp"
 
@@ -57,9 +58,9 @@ struct LogicalAgentOptions {
   /// Idle this long (shared clock) → drive to a free parking vertex; < 0: never.
   DurationNs park_after = seconds_to_ns(30);
   /// Below this state of charge the vehicle charges before new work; <= 0: never.
-  double charge_below = 0.2;
-  /// The state of charge a charge action aims at.
-  double charge_to = 0.9;
+  double charge_below = kDefaultChargeBelow;
+  /// The state of charge a charge action aims at (above charge_below: see charging_problem).
+  double charge_to = kDefaultChargeTo;
   /// A recoverable RAN error (stall, protective field, lost RAN) lasting longer fails the
   /// order with an alarm.
   DurationNs error_limit = seconds_to_ns(60);
@@ -77,7 +78,8 @@ struct LogicalAgentOptions {
 class LogicalAgent {
  public:
   /// \return the agent (its executor started), or invalid_argument (bad vehicle profile,
-  ///         lookahead 0), or the DDS layer's errors.
+  ///         lookahead 0, charging thresholds charging_problem refuses), or the DDS layer's
+  ///         errors.
   static Result<std::unique_ptr<LogicalAgent>> create(std::shared_ptr<const topology::Topology> topology,
                                                       SharedClock clock, LogicalAgentOptions options);
   /// Stops the executor (cancelling the current route's future reservations), then the
