@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 83..93 and 99. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 83..93, 99 and 100. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -211,6 +211,8 @@ struct Observations {
   std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, allocated to)
   std::uint64_t last_serial = 0;                                    ///< of the last topology event
   std::vector<std::string> cancelled;                               ///< agents whose route was cancelled
+  std::vector<std::pair<TimeNs, std::string>> releases;             ///< (time, agent) of each release
+  std::map<std::string, std::vector<TimeNs>> status_times;          ///< vehicle -> times of its statuses
 
   bool wait(const std::function<bool()>& condition, std::chrono::seconds timeout) {
     std::unique_lock lock(mutex);
@@ -313,6 +315,7 @@ class FleetTest : public ::testing::Test {
     seen_.last_serial = event.serial();
     if (event.kind() == msg::EVENT_CANCELLED) seen_.cancelled.push_back(event.agent());
     if (event.kind() == msg::EVENT_RELEASED) {
+      seen_.releases.emplace_back(event.time(), event.agent());
       if (seen_.holders[event.entity()] == event.agent()) seen_.holders[event.entity()].clear();
     } else if (event.kind() == msg::EVENT_ALLOCATED) {
       seen_.holders[event.entity()] = event.agent();
@@ -333,6 +336,7 @@ class FleetTest : public ::testing::Test {
   void on_status(const ran::VehicleStatus& status) {
     std::lock_guard lock(seen_.mutex);
     seen_.latest[status.vehicle_id] = status;
+    seen_.status_times[status.vehicle_id].push_back(status.time);
     for (const auto& [other, other_status] : seen_.latest) {
       if (other == status.vehicle_id) continue;
       const double area = topology::footprint_overlap_area(status.footprint, other_status.footprint);
@@ -854,6 +858,59 @@ TEST_F(FleetTest, WithdrawnOrdersEndAQueuedOneAtOnceARunningOneOnAVertexAndTheVe
   std::lock_guard lock(seen_.mutex);
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
+// A RAN out of reach mid-route: its cancel cannot be delivered and where it stands is not
+// known, so its logical agent keeps everything the vehicle was allowed onto until the vehicle
+// is seen again, stopped (before, it released all but the stale footprint's entities, and the
+// vehicle drove on through them once back).
+TEST_F(FleetTest, VehicleOutOfReachKeepsWhatItWasAllowedOntoUntilItIsSeenStandingAgain) {
+  constexpr std::uint32_t kDomain = 100;
+  Fleet fleet(kDomain, "lost");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  fleet.start_vehicle("V1", "left-0", {}, {"--park-after", "-1", "--charge-below", "0", "--error-limit", "4"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 2.0; })) << "V1 never started";
+  const TimeNs lost_at = clock_->now();
+  // Longer than the error limit and the 10 s (real) the agent waits for a cancelled vehicle to
+  // stand, together.
+  constexpr DurationNs kLost = seconds_to_ns(40);
+  ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::lose_connection, kLost, 10s));
+
+  // Silent for longer than the error limit: the order fails.
+  const auto lost = wait_order("v1-lost");
+  ASSERT_TRUE(lost.has_value());
+  EXPECT_EQ(lost->state(), msg::ORDER_FAILED);
+  EXPECT_NE(lost->failure().find("ran_lost"), std::string::npos) << lost->failure();
+  // Back in reach, it stops, and what it no longer needs is released: at most the vertex it
+  // stands on and the edges that vertex's footprint reaches into stay held.
+  ASSERT_TRUE(wait_status("V1", [&](const ran::VehicleStatus& s) { return s.time > lost_at + kLost / 2; }, 120s))
+      << "V1 never came back";
+  EXPECT_TRUE(seen_.wait(
+      [&] {
+        std::size_t vertices = 0;
+        for (const auto& [entity, holder] : seen_.holders) {
+          if (holder == "V1" && world_->is_vertex(*world_->find(entity))) ++vertices;
+        }
+        return vertices == 1;
+      },
+      60s))
+      << "V1 does not hold exactly the vertex it stands on";
+
+  std::lock_guard lock(seen_.mutex);
+  const auto& times = seen_.status_times["V1"];
+  const auto first_back = std::find_if(times.begin(), times.end(), [&](TimeNs t) { return t > lost_at + kLost / 2; });
+  ASSERT_NE(first_back, times.end());
+  // The entities already passed when the last status came may go (the vehicle has left
+  // them); nothing after, until the vehicle is seen again.
+  for (const auto& [time, agent] : seen_.releases) {
+    EXPECT_FALSE(agent == "V1" && time > lost_at + seconds_to_ns(2) && time < *first_back)
+        << "V1 released an entity " << ns_to_seconds(time - lost_at) << " s into its silence";
+  }
+  EXPECT_FALSE(alarm_seen(msg::ALARM_CRITICAL, "V1", "left its allocated area")) << "V1 drove outside what it held";
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
 }
 
 }  // namespace

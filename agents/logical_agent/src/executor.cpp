@@ -126,8 +126,17 @@ std::optional<topology::EntityIndex> LogicalAgent::vertex_under(const ran::Vehic
 }
 
 bool LogicalAgent::hold_position() {
-  const auto status = latest_status();
-  if (!status) return false;
+  // Moves whose cancel did not reach the RAN are cancelled first (it must not drive on), and
+  // a cancel is seen through until the vehicle stands.
+  if (!stop_vehicle()) return false;
+  std::optional<ran::VehicleStatus> status;
+  {
+    // Only a recent status of a vehicle standing still says where it is for good (a RAN
+    // out of reach may have left it anywhere on what it was allowed onto).
+    std::lock_guard lock(mutex_);
+    if (std::chrono::steady_clock::now() - status_received_ > kRanSilence || !fresh_and_standing(0)) return false;
+    status = status_;
+  }
   const auto vertex = vertex_under(*status);
   if (!vertex) {
     set_activity(Activity::error);
@@ -150,6 +159,7 @@ bool LogicalAgent::hold_position() {
   }
   position_alarm_raised_ = false;
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
+  release_passed(*status);  // what an earlier route left allocated and the vehicle does not need
   return true;
 }
 
@@ -553,21 +563,53 @@ void LogicalAgent::process_notices(bool& replan) {
   }
 }
 
-void LogicalAgent::stop_vehicle() {
-  if (pending_moves_.empty()) return;
-  const TimeNs asked = clock_.now();
-  if (auto cancelled = ran_->cancel(pending_moves_.front().first, options_.call_timeout); !cancelled) {
-    spdlog::warn("cancel of the moves not delivered: {}", cancelled.error().message);
+bool LogicalAgent::stop_vehicle() {
+  // The moves the RAN has not reported ended, oldest first: a cancel ends the move it names
+  // and every one queued after it, but the RAN refuses to cancel a move that has ended (the
+  // report may be on its way), so each is tried in turn.
+  std::vector<ran::CommandId> unended;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, target] : pending_moves_) {
+      if (!ended_commands_.contains(id)) unended.push_back(id);
+    }
+  }
+  if (!unended.empty()) {
+    bool delivered = false;
+    for (const auto& id : unended) {
+      auto cancelled = ran_->cancel(id, options_.call_timeout);
+      if (cancelled) {
+        delivered = true;
+        break;
+      }
+      if (nobody_answered(cancelled.error())) {  // the RAN is out of reach: said once
+        if (!stop_undelivered_) spdlog::warn("cancel of move '{}' not delivered: {}", id, cancelled.error().message);
+        stop_undelivered_ = true;
+        break;
+      }
+      spdlog::info("cancel of move '{}' not taken: {}", id, cancelled.error().message);
+    }
+    if (!delivered) return false;  // the moves stay pending: the next call cancels them
+    stop_undelivered_ = false;
+    stop_asked_ = clock_.now();
   }
   pending_moves_.clear();
+  if (!stop_asked_) return true;  // every move ended: nothing was cancelled
   // A cancelled vehicle brakes into what it was allowed onto: nothing may be released
   // before it stands, so wait (bounded) for a status after the cancel that shows it still.
   std::unique_lock lock(mutex_);
-  const bool standing = wake_.wait_for(lock, kStopWait, [&] {
-    return status_ && status_->time > asked && std::abs(status_->linear_speed) < 1e-3 &&
-           std::abs(status_->angular_speed) < 1e-3;
-  });
-  if (!standing) spdlog::warn("vehicle '{}' did not report standing still after the cancel", vehicle_id());
+  if (!wake_.wait_for(lock, kStopWait, [&] { return stopping_ || fresh_and_standing(*stop_asked_); }) ||
+      !fresh_and_standing(*stop_asked_)) {
+    spdlog::warn("vehicle '{}' did not report standing still after the cancel", vehicle_id());
+    return false;  // asked again by the next call
+  }
+  stop_asked_.reset();
+  return true;
+}
+
+bool LogicalAgent::fresh_and_standing(TimeNs since) const {
+  return status_ && status_->time > since && std::abs(status_->linear_speed) < 1e-3 &&
+         std::abs(status_->angular_speed) < 1e-3;
 }
 
 void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
@@ -578,13 +620,18 @@ void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
 
 void LogicalAgent::abandon_route() {
   if (!route_) return;
-  stop_vehicle();  // before anything is released
+  const bool stands = stop_vehicle();  // before anything is released
+  // The steps the vehicle holds stay reserved; the rest of the route goes.
   cancel_route_quietly(route_->id());
   monitor_.forget_steps();
-  if (const auto status = latest_status()) {
+  if (const auto status = latest_status(); status && stands) {
     for (const auto entity : monitor_.releasable(status->footprint, 0)) {
       if (services_->release(vehicle_id(), entity, monitor_.granted_as(entity))) monitor_.drop(entity);
     }
+  } else {
+    // Where the vehicle is, or whether it still rolls, is unknown: it keeps everything it
+    // was allowed onto until hold_position sees it stand again.
+    spdlog::warn("vehicle '{}' not known to stand: keeping its {} allocation(s)", vehicle_id(), monitor_.held().size());
   }
   route_.reset();
 }

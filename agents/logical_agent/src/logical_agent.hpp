@@ -115,7 +115,9 @@ class LogicalAgent {
   /// Waits for an event or the tick. \return false when stopping.
   bool wait_event();
   std::optional<ran::VehicleStatus> latest_status();
-  /// Finds the vertex the vehicle stands on and holds it with a route to itself.
+  /// Finds the vertex the vehicle stands on and holds it with a route to itself (once a
+  /// recent status shows it standing, after cancelling moves the RAN may still run), then
+  /// releases what earlier routes left allocated that the vehicle does not need.
   /// \return whether it holds one now.
   bool hold_position();
   std::optional<topology::EntityIndex> vertex_under(const ran::VehicleStatus& status) const;
@@ -159,15 +161,23 @@ class LogicalAgent {
   /// Drives the standing vehicle off its vertex to a free parking vertex, for whoever
   /// asked. \return whether it moved.
   bool make_way(const std::string& requester);
-  /// Gives up the current route after a failure: cancels its reservations, releases what
-  /// the footprint does not touch, holds the vertex the vehicle stands on again.
+  /// Gives up the current route after a failure: stops the vehicle, cancels the route's
+  /// reservations but for the steps it holds, and, once the vehicle is known to stand,
+  /// releases what the footprint does not need (otherwise hold_position does, later).
   void abandon_route();
   /// Cancels a route of ours on every topology agent; failures are logged.
   void cancel_route_quietly(topology::RouteId route);
   void release_passed(const ran::VehicleStatus& status);
   void process_notices(bool& replan);
   void propagate_delay(std::size_t from_step, DurationNs by);
-  void stop_vehicle();
+  /// Cancels the moves the RAN has not ended and waits (bounded) for a status after the
+  /// cancel showing the vehicle still. \return whether it is known to stand with nothing
+  /// commanded; false when the cancel did not reach the RAN (the moves stay pending, the
+  /// next call cancels them) or no such status came (the next call waits for one again).
+  bool stop_vehicle();
+  /// Whether the latest status is later than `since` and shows the vehicle still.
+  /// \pre mutex_ is held
+  bool fresh_and_standing(TimeNs since) const;
   /// Checks the RAN's errors. \return a failure reason once the order must fail.
   std::optional<std::string> check_errors(const ran::VehicleStatus& status);
   void raise_alarm(msg::AlarmSeverity severity, const std::string& text);
@@ -210,6 +220,9 @@ class LogicalAgent {
   std::uint64_t seen_events_ = 0;
   Activity drive_activity_ = Activity::driving;
   TimeNs charge_retry_at_ = 0;
+  /// When a cancel of moves reached the RAN that no standing status has confirmed yet.
+  std::optional<TimeNs> stop_asked_;
+  bool stop_undelivered_ = false;  ///< a cancel did not reach the RAN (warned once)
   bool position_alarm_raised_ = false;
   bool making_way_ = false;                          ///< driving aside: requests wait
   std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked
