@@ -128,11 +128,33 @@ void RoutingAgent::on_route(const msg::RouteRequest& request, dds::ReplyHandle<m
     out.error(dds::to_wire(served.error().error));
     out.failure(served.error().failure);
     out.blockers(served.error().blockers);
-    out.route(request.route());
+    out.route(served.error().route != 0 ? served.error().route : request.route());
   }
   if (auto sent = reply.send(std::move(out)); !sent) {
     spdlog::warn("route reply to '{}' not sent: {}", reply.requester(), sent.error().message);
   }
+}
+
+bool RoutingAgent::cancel_route_on(const std::string& agent, topology::RouteId route, const std::string& owner) {
+  // A topology agent that did not answer a commit in time may be busy or restarting: the
+  // cancel gets a few call timeouts, not one.
+  constexpr int kAttempts = 3;
+  msg::CancelRouteRequest cancel;
+  cancel.agent(agent);
+  cancel.route(route);
+  std::string why;
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    auto cancelled = cancel_client_->call(cancel, options_.call_timeout, owner);
+    if (cancelled) {
+      const auto code = cancelled->error().code();
+      if (code == msg::ERROR_NONE || code == msg::ERROR_NOT_FOUND) return true;  // gone, or never committed
+      why = cancelled->error().message();
+      break;
+    }
+    why = cancelled.error().message;
+  }
+  spdlog::error("route {} of '{}': could not undo the commit on '{}': {}", route, agent, owner, why);
+  return false;
 }
 
 Result<carp::PlanRequest, RoutingAgent::RouteError> RoutingAgent::prepare_model(std::unique_lock<std::mutex>& lock,
@@ -335,9 +357,10 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
       return unexpected(RouteError{Error{ErrorCode::unavailable, "routing agent '" + agent_id() + "' shut down"}, {}});
     }
 
-    // Commit everywhere. A commit that fails (the hold expired) undoes the others.
+    // Commit everywhere. A commit that fails (the hold expired) undoes the others. One whose
+    // reply never came may have been applied: it is undone too.
     std::optional<Error> commit_failed;
-    std::vector<PartitionShare*> committed;
+    std::vector<PartitionShare*> to_undo;
     for (auto& share : shares) {
       msg::ReserveCommitRequest commit;
       commit.prepare_id(share.prepare_id);
@@ -345,24 +368,21 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
       Status status = done ? dds::from_wire(done->error()) : Status(unexpected(std::move(done).error()));
       if (!status) {
         commit_failed = Error{status.error().code, "commit on topology agent '" + share.owner + "': " + status.error().message};
+        if (!done) to_undo.push_back(&share);
         break;
       }
       share.prepare_id = 0;
-      committed.push_back(&share);
+      to_undo.push_back(&share);
     }
     if (commit_failed) {
       abort_all(shares);
-      for (auto* share : committed) {
-        msg::CancelRouteRequest cancel;
-        cancel.agent(plan.agent);
-        cancel.route(route_id);
-        auto cancelled = cancel_client_->call(cancel, options_.call_timeout, share->owner);
-        if (!cancelled || cancelled->error().code() != msg::ERROR_NONE) {
-          spdlog::error("route {} of '{}': could not undo the commit on '{}': {}", route_id, plan.agent, share->owner,
-                        cancelled ? cancelled->error().message() : cancelled.error().message);
-        }
+      bool undone = true;
+      for (auto* share : to_undo) undone = cancel_route_on(plan.agent, route_id, share->owner) && undone;
+      if (commit_failed->code != ErrorCode::not_found) {
+        RouteError error{*commit_failed, {}};
+        if (!undone) error.route = route_id;  // the client may still cancel what is left
+        return unexpected(std::move(error));
       }
-      if (commit_failed->code != ErrorCode::not_found) return unexpected(RouteError{*commit_failed, {}});
       last_conflict = Error{ErrorCode::conflict, commit_failed->message + " (the hold expired)"};
       continue;
     }

@@ -78,6 +78,9 @@ class RoutingAgent {
     Error error;
     std::string failure;
     std::vector<std::string> blockers;  ///< carp::PlanError::blockers
+    /// The route id the reply names: the request's, or, when a commit's outcome stayed
+    /// unknown, the id its reservations may be under (so that the client can cancel them).
+    topology::RouteId route = 0;
   };
   static RouteError plan_failure(const carp::PlanError& error);
   template <class Req, class Rep>
@@ -96,6 +99,10 @@ class RoutingAgent {
   Result<carp::PlanRequest, RouteError> prepare_model(std::unique_lock<std::mutex>& lock,
                                                       const msg::RouteRequest& request);
   Result<msg::RouteReply, RouteError> serve_real(const msg::RouteRequest& request, carp::PlanRequest plan);
+  /// Cancels `agent`'s route `route` on topology agent `owner`, held or committed, asking
+  /// again (a few times) while nobody answers. \return whether it is gone there (or was
+  /// never there); false, logged, when it could not be made sure of.
+  bool cancel_route_on(const std::string& agent, topology::RouteId route, const std::string& owner);
 
   /// The live topology agent that owns `partition`, from the heartbeats.
   Result<std::string> owner_of(const std::string& partition) const;

@@ -196,6 +196,7 @@ TopologyAgent::~TopologyAgent() {
     send_error(handle, Error{ErrorCode::unavailable, "topology agent '" + agent_id() + "' shut down"});
   }
   waiting_replies_.clear();
+  unanswered_commits_.clear();
 }
 
 Result<topology::EntityIndex> TopologyAgent::known_entity(const std::string& id) const {
@@ -275,6 +276,12 @@ void TopologyAgent::on_commit(const msg::ReserveCommitRequest& request, StatusHa
       }
     }
     committed = after_change(timelines_.take_grants(), std::move(events));
+  }
+  if (options_.drop_commit_replies) {
+    spdlog::warn("drop-commit-replies: commit of prepare {} {}, reply not sent (test hook)", request.prepare_id(),
+                 committed ? "applied" : "refused");
+    unanswered_commits_.push_back(std::move(reply));
+    return;
   }
   send_status(reply, committed);
 }

@@ -53,6 +53,9 @@ struct TopologyAgentOptions {
   std::filesystem::path journal_file;
   /// How often prepared holds past their expiry are dropped.
   std::chrono::milliseconds expiry_period{100};
+  /// TEST HOOK: commits are applied but never answered (a reply lost on the way), so that
+  /// tests can check what a routing agent does with a commit of unknown outcome.
+  bool drop_commit_replies = false;
 };
 
 /// Thread-safe; serves from the moment create() returns until it is destroyed.
@@ -159,6 +162,7 @@ class TopologyAgent {
     std::vector<topology::Reservation> real_items;  // its real reservations, as prepared
   };
   std::map<topology::PrepareId, PreparedRoute> prepared_;  // to tell owners of expired holds
+  std::vector<StatusHandle> unanswered_commits_;            // drop_commit_replies
   /// Allocation requests with wait = true that are queued: answered when granted.
   std::multimap<std::pair<std::string, topology::EntityIndex>, AllocateHandle> waiting_replies_;
 

@@ -27,6 +27,7 @@ struct TopologyAgentArguments {
   std::string xml_profile;
   ClockArguments clock;
   std::string log_level = "info";
+  bool drop_commit_replies = false;
 };
 
 int run(const TopologyAgentArguments& arguments) {
@@ -50,6 +51,7 @@ int run(const TopologyAgentArguments& arguments) {
   topology_agent::TopologyAgentOptions options;
   options.partition = arguments.partition;
   options.journal_file = arguments.journal_file;
+  options.drop_commit_replies = arguments.drop_commit_replies;
   options.participant.domain_id = arguments.domain_id;
   options.participant.agent_id = agent_id;
   options.participant.xml_profile_file = arguments.xml_profile;
@@ -91,6 +93,8 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
   add_clock_options(*command, arguments->clock);
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  command->add_flag("--drop-commit-replies", arguments->drop_commit_replies,
+                    "TEST HOOK: apply commits but never answer them (a reply lost on the way)");
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }
 

@@ -540,6 +540,27 @@ TEST_F(RoutingAgentTest, HoldsOfARoutingAgentKilledBetweenPrepareAndCommitExpire
   EXPECT_EQ(reply.arrival(), start + seconds_to_ns(9)) << "v2 drove straight through, nothing in its way";
 }
 
+// A commit whose reply is lost may have been applied: the routing agent undoes it there too,
+// so no partition keeps a route nobody knows of (here east applies it, its destination held
+// for ever, and the client hears a failure).
+TEST_F(RoutingAgentTest, ACommitOfUnknownOutcomeIsUndoneOnItsPartitionToo) {
+  constexpr std::uint32_t kDomain = 55;
+  use_line_topology();
+  start("topology-west", {"topology-agent", "--topology", topology_file_, "--partition", "west", "--domain",
+                          std::to_string(kDomain)});
+  start("topology-east", {"topology-agent", "--topology", topology_file_, "--partition", "east", "--domain",
+                          std::to_string(kDomain), "--drop-commit-replies"});
+  start_routing_agent(kDomain, "routing-1");
+  connect(kDomain, 2);
+
+  const auto reply = call(route_request("v1", "a", "d", true, SharedClock::wall().now() + seconds_to_ns(60)));
+  EXPECT_NE(reply.error().code(), msg::ERROR_NONE) << "the route was reported reserved";
+  EXPECT_NE(reply.error().message().find("commit on topology agent 'topology-east'"), std::string::npos)
+      << reply.error().message();
+  ASSERT_TRUE(wait_until([&] { return reservations_of("v1").empty(); }))
+      << "a partition keeps the route: " << reservations_of("v1").size() << " item(s) of v1 left";
+}
+
 // An operator's lock (droverctl lock, as a process) makes new routes go round the entity;
 // unlocking it (droverctl unlock) makes it usable again.
 TEST_F(RoutingAgentTest, LockMakesNewRoutesAvoidTheEntityAndUnlockRestoresIt) {

@@ -245,6 +245,10 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
       return RouteTracker(topology_, reply->route(), std::move(steps));
     } else {
       const std::string& failure = reply->failure();
+      // A topology agent did not answer the routing agent: part of the route may be
+      // reserved under this id (a commit whose reply was lost), so it is cancelled before
+      // asking again under a new one.
+      if (nobody_answered(status.error())) cancel_route_quietly(id);
       const bool blocked = failure == "no_window" || failure == "locked" || failure == "conflict" ||
                            nobody_answered(status.error());
       if (!blocked || clock_.now() >= give_up) {
