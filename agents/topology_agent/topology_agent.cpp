@@ -100,7 +100,14 @@ TopologyAgent::TopologyAgent(topology::Topology topology, SharedClock clock, Top
       participant_(std::move(participant)),
       timelines_(std::move(timelines)),
       journal_(std::move(journal)),
-      published_versions_(topology_.entity_count(), 0) {}
+      published_versions_(topology_.entity_count(), 0) {
+  // A queued request is granted when what stood before it goes (release, cancel, commit,
+  // abort, expiry): by the same lock rule as a request that arrives (on_allocate). Called
+  // by the set under mutex_.
+  timelines_.set_grant_filter([this](const topology::AgentId& agent, topology::EntityIndex entity) {
+    return first_step_of_route(entity, agent) || !locked_now(entity);
+  });
+}
 
 std::vector<std::string> TopologyAgent::served_partitions() const {
   if (!options_.partition.empty()) return {options_.partition};

@@ -1,5 +1,5 @@
 // The topology agent as a process (`drover topology-agent`): the test process is its
-// client over DDS. Domains 60 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
+// client over DDS. Domains 60, 66 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 
@@ -391,6 +391,33 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequest
     }
     return false;
   }));
+}
+
+// A lock in force keeps a vehicle off the entity however its request came: a request queued
+// before the lock is not granted by the release that would have let it on.
+TEST_F(TopologyAgentTest, AQueuedRequestIsNotGrantedWhileALockIsInForce) {
+  start_agent(66);
+  connect(66);
+  reserve("v1", 1, {{"b", {1000, 2000}}});
+  reserve("v2", 1, {{"d", {2000, 3000}}, {"b", {3000, 4000}}});  // b is v2's step 1, not where it stands
+  ASSERT_TRUE(allocate("v1", "b", false).granted());
+  auto waiting = std::async(std::launch::async, [this] { return allocate("v2", "b", true); });
+  ASSERT_TRUE(wait_until([&] { return timelines_["b"].waiting() == std::vector<std::string>{"v2"}; }));
+  const auto locked = lock("b", 0, kForever / 2);
+  ASSERT_EQ(locked.error().code(), msg::ERROR_NONE) << locked.error().message();
+  EXPECT_FALSE(allocate("v2", "b", false).granted()) << "a new request under the lock";
+
+  EXPECT_EQ(release("v1", "b").error().code(), msg::ERROR_NONE);
+  EXPECT_TRUE(wait_until([&] { return timelines_["b"].holder().empty(); })) << "v1's release never showed";
+  EXPECT_EQ(waiting.wait_for(0s), std::future_status::timeout) << "v2 was answered: granted under the lock";
+  EXPECT_TRUE(wait_until([&] { return timelines_["b"].waiting() == std::vector<std::string>{"v2"}; }))
+      << "v2 stays queued";
+  // The agent asks again once the lock is gone (no grant comes when a lock ends).
+  ASSERT_EQ(unlock(locked.lock_id()).error().code(), msg::ERROR_NONE);
+  const auto granted = allocate("v2", "b", false);
+  EXPECT_EQ(granted.error().code(), msg::ERROR_NONE) << granted.error().message();
+  EXPECT_TRUE(granted.granted());
+  EXPECT_TRUE(waiting.get().granted()) << "the queued request is answered by the grant";
 }
 
 TEST_F(TopologyAgentTest, ALockNotifiesTheOwnersOfHitReservationsAndUnlockRemovesIt) {

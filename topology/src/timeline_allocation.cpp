@@ -39,6 +39,7 @@ std::vector<Grant> TimelineSet::Impl::grant_waiting(TimelineSet& set, const Touc
     for (auto waiting = t.waiting.begin(); waiting != t.waiting.end(); ++waiting) {
       const Reservation* mine = first_committed_real(t, *waiting);
       if (others_before(t, *waiting, mine->window.start) > 0) continue;
+      if (set.grant_filter_.may_grant && !set.grant_filter_.may_grant(*waiting, entity)) continue;
       set.held_[entity] = AllocatedStep{mine->route, mine->step};
       t.holder = *waiting;
       revise_around(set, entity);

@@ -329,6 +329,12 @@ class TimelineSet {
   /// ascending. Waiting requests this makes grantable are granted (see take_grants).
   std::vector<PrepareId> expire(TimeNs now);
 
+  /// Rules of the set's owner beyond reservation order (no clock here: locks in force now,
+  /// say): a waiting request is granted only where `may_grant(agent, entity)` is true; one
+  /// refused stays queued (the agent asks again). Empty: every grantable request is granted.
+  using GrantFilter = std::function<bool(const AgentId& agent, EntityIndex entity)>;
+  void set_grant_filter(GrantFilter may_grant) { grant_filter_.may_grant = std::move(may_grant); }
+
   /// The grants that commit, abort and expire made since the last call, in the order they
   /// were made. (Aborting or expiring frees held items a waiting request may queue behind;
   /// committing may put a waiting agent's new reservation before everyone else's. These
@@ -507,6 +513,13 @@ class TimelineSet {
   };
   Newcomers newcomers_;
   std::vector<Grant> pending_grants_;             // see take_grants
+  /// The owner's rule (set_grant_filter), not the set's state: sets compare equal whatever
+  /// their filters.
+  struct GrantFilterSlot {
+    GrantFilter may_grant;
+    friend bool operator==(const GrantFilterSlot&, const GrantFilterSlot&) { return true; }
+  };
+  GrantFilterSlot grant_filter_;
   LockId next_lock_id_ = 1;
   PrepareId next_prepare_id_ = 1;
 };
