@@ -209,6 +209,26 @@ TEST(LaunchFile, BadProfileFields) {
   EXPECT_NE(text.find("vehicle_profiles.y: must be an object"), std::string::npos) << text;
 }
 
+// What the agents would refuse at start, after the rest of the fleet started: a battery
+// fuller than it holds, orders without two distinct stations to go between.
+TEST(LaunchFile, BatteriesOverTheirCapacityAndTooFewStationsAreRefused) {
+  const auto text = problems_of(R"({"topology": "topologies/loop.json",
+      "vehicle_profiles": {"x": {"battery": 2000}, "y": {"battery": 600, "battery_capacity": 500},
+                           "z": {"battery": 400, "battery_capacity": 500}},
+      "agents": [{"kind": "routing"},
+                 {"kind": "load-generator", "id": "twice", "stations": ["station", "station"]},
+                 {"kind": "load-generator", "id": "loop-stations"}]})");
+  EXPECT_NE(text.find("vehicle_profiles.x.battery: must be at most the battery capacity (1000 Wh)"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("vehicle_profiles.y.battery: must be at most the battery capacity (500 Wh)"), std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("vehicle_profiles.z"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[1].stations: a station is named twice"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[2].stations: the topology's stations: orders need at least two distinct stations, "
+                      "got 1 (name them)"),
+            std::string::npos) << text;
+}
+
 TEST(LaunchFile, DuplicateIdsAndVehicles) {
   const auto text = problems_of(loop_file(R"({"kind": "routing"}, {"kind": "routing"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},

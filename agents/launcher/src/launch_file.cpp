@@ -16,6 +16,8 @@
 #include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
+#include "drover/launcher/load_generator.hpp"
+#include "drover/ran/sim_vehicle.hpp"
 #include "drover/logical_agent/charging.hpp"
 #include "drover/topology/topology_file.hpp"
 
@@ -296,6 +298,15 @@ class LaunchFileParser {
           parsed.logical[key] = value;
         }
       }
+      // The simulated vehicle starts with a full battery unless told otherwise, and never
+      // with more than it holds.
+      const auto battery = profile.find("battery");
+      const auto capacity = profile.find("battery_capacity");
+      const double holds = capacity != profile.end() && capacity->is_number() ? capacity->get<double>()
+                                                                              : ran::SimVehicleConfig{}.battery_capacity_wh;
+      if (battery != profile.end() && battery->is_number() && battery->get<double>() > holds) {
+        checker_.problem(join(where, "battery"), fmt::format("must be at most the battery capacity ({} Wh)", holds));
+      }
       profiles_[name] = std::move(parsed);
     }
   }
@@ -374,6 +385,7 @@ class LaunchFileParser {
       checker_.problem(join(where, "at"), "missing: the vertex the vehicle starts at");
     }
     if (rules->kind == AgentKind::logical) check_charging(entry, where);
+    if (rules->kind == AgentKind::load_generator) check_stations(entry, where);
     if (rules->kind == AgentKind::logical && !agent.id.empty() && agent.id != agent.vehicle) {
       checker_.problem(join(where, "id"), "a logical agent's id is its vehicle id: leave it out");
     }
@@ -413,6 +425,29 @@ class LaunchFileParser {
     const double to = number_or("charge_to", logical_agent::kDefaultChargeTo);
     if (!(below >= 0 && below <= 1 && to > 0 && to <= 1)) return;
     if (auto problem = logical_agent::charging_problem(below, to)) checker_.problem(join(where, "charge_to"), *problem);
+  }
+
+  /// A load generator's stations together: the ones named, or every station of the topology.
+  void check_stations(const Json& entry, const std::string& where) {
+    std::vector<std::string> stations;
+    const auto named = entry.find("stations");
+    if (named != entry.end()) {
+      if (!named->is_array()) return;  // reported by its rule
+      for (const auto& id : *named) {
+        if (id.is_string()) stations.push_back(id.get<std::string>());
+      }
+    } else if (topology_) {
+      for (const auto& vertex : topology_->vertices()) {
+        if (vertex.kind == topology::VertexKind::station) stations.push_back(vertex.id);
+      }
+    } else {
+      return;  // the topology's own problems are reported already
+    }
+    if (auto problem = stations_problem(stations)) {
+      checker_.problem(join(where, "stations"), named != entry.end()
+                                                    ? *problem
+                                                    : "the topology's stations: " + *problem + " (name them)");
+    }
   }
 
   static std::string default_id(const KindRules& rules, const AgentEntry& agent, const Json& entry) {

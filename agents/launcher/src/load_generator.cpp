@@ -29,12 +29,19 @@ LoadGenerator::LoadGenerator(LoadGeneratorOptions options)
       served_(options_.vehicles.begin(), options_.vehicles.end()),
       picker_(options_.stations, options_.seed) {}
 
+std::optional<std::string> stations_problem(const std::vector<std::string>& stations) {
+  const std::set<std::string> distinct(stations.begin(), stations.end());
+  if (distinct.size() != stations.size()) return "a station is named twice";
+  if (distinct.size() < 2) {
+    return "orders need at least two distinct stations, got " + std::to_string(distinct.size());
+  }
+  return std::nullopt;
+}
+
 Result<std::unique_ptr<LoadGenerator>> LoadGenerator::create(dds::Participant& participant,
                                                              LoadGeneratorOptions options) {
-  const std::set<std::string> distinct(options.stations.begin(), options.stations.end());
-  if (distinct.size() < 2 || distinct.size() != options.stations.size()) {
-    return fail(ErrorCode::invalid_argument, "the load generator needs at least two distinct stations, got " +
-                                                 std::to_string(options.stations.size()));
+  if (auto problem = stations_problem(options.stations)) {
+    return fail(ErrorCode::invalid_argument, "the load generator's stations: " + *problem);
   }
   if (options.order_prefix.empty()) options.order_prefix = participant.agent_id();
   std::unique_ptr<LoadGenerator> generator(new LoadGenerator(std::move(options)));

@@ -153,7 +153,8 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--deceleration", vehicle.deceleration, "m/s^2 (default 0.5)")->transform(cli::positive());
   sim->add_option("--angular-speed", vehicle.angular_speed, "rad/s turning on the spot (default 1)")->transform(cli::positive());
   sim->add_option("--battery-capacity", vehicle.battery_capacity_wh, "Wh (default 1000)")->transform(cli::positive());
-  sim->add_option("--battery", vehicle.battery_initial_wh, "Wh at start (default 1000)")->transform(cli::non_negative());
+  auto* battery = sim->add_option("--battery", vehicle.battery_initial_wh, "Wh at start (default: full, the capacity)")
+                      ->transform(cli::non_negative());
   sim->add_option("--drain", vehicle.drain_wh_per_metre, "Wh per metre driven (default 0.5)")->transform(cli::non_negative());
   sim->add_option("--charge-rate", vehicle.charge_wh_per_second, "Wh per second charging (default 1)")->transform(cli::non_negative());
   sim->add_option("--load-duration", arguments->load_seconds, "s (default 5)")
@@ -163,7 +164,10 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--custom-action", arguments->custom_actions,
                   "A custom action the vehicle supports: NAME=SECONDS (repeatable)");
   sim->add_flag("--loaded", arguments->loaded, "Start loaded");
-  sim->callback([arguments, &context] { context.exit_code = run(*arguments); });
+  sim->callback([arguments, battery, &context] {
+    if (battery->count() == 0) arguments->vehicle.battery_initial_wh = arguments->vehicle.battery_capacity_wh;
+    context.exit_code = run(*arguments);
+  });
 }
 
 }  // namespace drover::cli

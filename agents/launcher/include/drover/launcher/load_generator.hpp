@@ -47,11 +47,15 @@ struct LoadFigures {
   std::uint64_t withdrawn = 0;  ///< of ours, withdrawn (by an operator)
 };
 
+/// Why `stations` cannot serve a load generator, if they cannot: orders go between two
+/// distinct stations, so at least two, none named twice.
+std::optional<std::string> stations_problem(const std::vector<std::string>& stations);
+
 /// Thread-safe. Must be destroyed before its Participant.
 class LoadGenerator {
  public:
-  /// \return the generator, or invalid_argument (fewer than two stations), or the DDS
-  ///         layer's errors.
+  /// \return the generator, or invalid_argument (stations_problem), or the DDS layer's
+  ///         errors.
   static Result<std::unique_ptr<LoadGenerator>> create(dds::Participant& participant,
                                                        LoadGeneratorOptions options);
   ~LoadGenerator();
