@@ -131,10 +131,10 @@ bool LogicalAgent::hold_position() {
   if (!stop_vehicle()) return false;
   std::optional<ran::VehicleStatus> status;
   {
-    // Only a recent status of a vehicle standing still says where it is for good (a RAN
-    // out of reach may have left it anywhere on what it was allowed onto).
+    // Only a recent status says where the vehicle is (a RAN out of reach may have left it
+    // anywhere on what it was allowed onto); that it stands, stop_vehicle saw to.
     std::lock_guard lock(mutex_);
-    if (std::chrono::steady_clock::now() - status_received_ > kRanSilence || !fresh_and_standing(0)) return false;
+    if (!status_ || std::chrono::steady_clock::now() - status_received_ > kRanSilence) return false;
     status = status_;
   }
   const auto vertex = vertex_under(*status);
