@@ -232,6 +232,30 @@ TEST_F(TimelineTest, PrepareReportsUnknownEntitiesAndConflictsInThatOrder) {
             ErrorCode::not_found);
 }
 
+// A step comes whole, as expand() writes it on the owned entities: a real item without its
+// shadows would let another agent reserve a conflicting entity at the same time.
+TEST(TimelinePartition, PrepareRefusesAStepWithoutTheShadowsOnOwnedEntities) {
+  const std::vector<std::vector<EntityIndex>> conflicts{{1}, {0}, {}};  // 0 and 1 conflict
+  TimelineSet set(conflicts);
+  const Reservation real{"amy", 7, 0, 0, 0, {0, 10}, false};
+  const TimelineSet before = set;
+  const auto alone = set.prepare({real}, {}, 1'000);
+  ASSERT_FALSE(alone.has_value());
+  EXPECT_EQ(alone.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(alone.error().message.find("step 0 (entity 0) has 1 item(s) here, not 2"), std::string::npos)
+      << alone.error().message;
+  EXPECT_TRUE(set == before);
+  // A shadow alone, its origin's real item missing where that is owned: refused too.
+  EXPECT_EQ(set.prepare({Reservation{"amy", 7, 0, 1, 0, {0, 10}, false}}, {}, 1'000).error().code,
+            ErrorCode::invalid_argument);
+  EXPECT_TRUE(set.prepare(set.expand("amy", 7, {RouteStep{0, {0, 10}}}), {}, 1'000).has_value());
+
+  // Across a partition border each owner gets its part: the shadow on 1 alone where only 1
+  // is owned (the real item on 0 is another partition's).
+  TimelineSet east(conflicts, {false, true, false});
+  EXPECT_TRUE(east.prepare({Reservation{"amy", 7, 0, 1, 0, {0, 10}, false}}, {}, 1'000).has_value());
+}
+
 TEST_F(TimelineTest, PrepareChecksExpectedVersions) {
   ASSERT_TRUE(set.reserve("bob", 1, {at(2, 0, 10)}));
   const auto items = set.expand("amy", 1, {at(3, 0, 10)});

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -128,6 +129,29 @@ Status TimelineSet::Impl::admit(const TimelineSet& set, const std::vector<Reserv
       return fail(ErrorCode::not_found, op + ": expected version of entity " +
                                             std::to_string(ev.entity) +
                                             ", which this set does not own");
+    }
+  }
+  // Every step whole, as expand() writes it on owned entities: a real item without its
+  // shadows would let another agent reserve a conflicting entity at the same time (I1), and
+  // the journal of such a state is refused on restore. check_well_formed saw to it that
+  // each item is the origin or a member of its conflict set, once; so counts suffice.
+  std::map<std::uint32_t, std::pair<EntityIndex, std::size_t>> steps;  // step -> origin, items
+  for (const Reservation& item : items) {
+    auto& [origin, count] = steps.try_emplace(item.step, item.origin, 0).first->second;
+    ++count;
+  }
+  for (const auto& [step, found] : steps) {
+    const auto& [origin, count] = found;
+    const auto& conflicts = set.conflict_sets_[origin];
+    const std::size_t owned = (set.owns(origin) ? 1 : 0) +
+                              static_cast<std::size_t>(std::count_if(conflicts.begin(), conflicts.end(),
+                                                                     [&set](EntityIndex e) { return set.owns(e); }));
+    if (count != owned) {
+      return fail(ErrorCode::invalid_argument,
+                  op + ": step " + std::to_string(step) + " (entity " + std::to_string(origin) + ") has " +
+                      std::to_string(count) + " item(s) here, not " + std::to_string(owned) +
+                      ": the real reservation where its entity is owned and a shadow on every owned "
+                      "member of its conflict set, as expand() writes them");
     }
   }
   for (const ExpectedVersion& ev : expected) {

@@ -316,7 +316,9 @@ class TimelineSet {
   /// has reservations here. invalid_argument too: an empty agent id, a shadow that is not
   /// on a member of its origin's conflict set, items of one step with different origins
   /// or windows, the same item twice. Checks run in that order of codes: every
-  /// invalid_argument first, then not_found, then conflict.
+  /// invalid_argument first, then not_found, then invalid_argument for a step without all
+  /// the items expand() writes on owned entities (the real item where its entity is owned,
+  /// a shadow on every owned member of its conflict set), then conflict.
   Result<PrepareId> prepare(const std::vector<Reservation>& items,
                             const std::vector<ExpectedVersion>& expected, TimeNs expires_at);
   /// Makes a prepared set permanent. not_found if it was aborted or expired. Waiting
