@@ -96,11 +96,11 @@ class ProgressWatch {
 /// Members in the order they are made: destroyed the other way round, the DDS entities go
 /// before their participant and the reader before the watch it calls.
 template <class Request, class Reply>
-struct OrderSession {
-  std::unique_ptr<dds::Participant> participant;
-  ProgressWatch watch;
-  std::unique_ptr<dds::Reader<msg::OrderProgress>> progress;
-  std::unique_ptr<dds::ServiceClient<Request, Reply>> client;
+class OrderSession {
+  std::unique_ptr<dds::Participant> participant_;
+  ProgressWatch watch_;
+  std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_;
+  std::unique_ptr<dds::ServiceClient<Request, Reply>> client_;
 
   /// \return kExitOk, or the exit code after printing why it could not be opened.
   int open(const DdsToolOptions& options, const char* service, const std::string& order, double wait_seconds) {
@@ -109,37 +109,67 @@ struct OrderSession {
       std::cerr << "error: " << opened.error().message << "\n";
       return opened.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
     }
-    participant = std::move(*opened);
-    watch.watch(order);
+    participant_ = std::move(*opened);
+    watch_.watch(order);
     if (wait_seconds > 0) {
       auto reader = dds::Reader<msg::OrderProgress>::create(
-          *participant, logical_agent::kOrderProgressTopic,
-          [this](const msg::OrderProgress& sample) { watch.on_progress(sample); });
+          *participant_, logical_agent::kOrderProgressTopic,
+          [this](const msg::OrderProgress& sample) { watch_.on_progress(sample); });
       if (!reader) {
         std::cerr << "error: " << reader.error().message << "\n";
         return kExitFailure;
       }
-      progress = std::move(*reader);
+      progress_ = std::move(*reader);
     }
-    auto made = dds::ServiceClient<Request, Reply>::create(*participant, logical_agent::kServiceArea, service);
+    auto made = dds::ServiceClient<Request, Reply>::create(*participant_, logical_agent::kServiceArea, service);
     if (!made) {
       std::cerr << "error: " << made.error().message << "\n";
       return kExitFailure;
     }
-    client = std::move(*made);
+    client_ = std::move(*made);
     return kExitOk;
   }
-  /// The order's end within `wait_seconds`, if it came.
-  std::optional<msg::OrderProgress> wait_end(double wait_seconds) {
-    return watch.wait(std::chrono::milliseconds(static_cast<std::int64_t>(wait_seconds * 1000)));
+
+ public:
+  /// Opens the session, then sends `request` to `vehicle`'s logical agent. \return its reply
+  /// when the agent accepted the request; otherwise nullopt, with the reason printed and
+  /// `exit_code` set (`refused` says what a refusing agent did not do: "refused order 'x'").
+  std::optional<Reply> ask(const DdsToolOptions& options, const char* service, const std::string& vehicle,
+                           const Request& request, const std::string& order, double wait_seconds,
+                           const std::string& refused, int& exit_code) {
+    exit_code = open(options, service, order, wait_seconds);
+    if (exit_code != kExitOk) return std::nullopt;
+    auto reply = client_->call(request, options.timeout(), vehicle);
+    if (!reply) {
+      std::cerr << "error: vehicle '" << vehicle << "': " << reply.error().message << "\n";
+      exit_code = reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
+      return std::nullopt;
+    }
+    if (auto status = dds::from_wire(reply->error()); !status) {
+      std::cerr << "error: vehicle '" << vehicle << "' " << refused << ": " << status.error().message << "\n";
+      exit_code = kExitFailure;
+      return std::nullopt;
+    }
+    return std::move(*reply);
+  }
+  /// Waits up to `wait_seconds` for `order` to end in state `expected`. \return kExitOk after
+  /// printing "order 'x' <done>", or kExitFailure after printing "... <not_done> within S s"
+  /// or how it ended otherwise followed by `otherwise`.
+  int await_end(const std::string& order, double wait_seconds, msg::OrderState expected, const char* done,
+                const char* not_done, const char* otherwise) {
+    const auto final_state = watch_.wait(std::chrono::milliseconds(static_cast<std::int64_t>(wait_seconds * 1000)));
+    if (!final_state) {
+      std::cerr << "error: order '" << order << "' " << not_done << " within " << wait_seconds << " s\n";
+      return kExitFailure;
+    }
+    if (final_state->state() != expected) {
+      std::cerr << "error: order '" << order << "' " << end_text(*final_state) << otherwise << "\n";
+      return kExitFailure;
+    }
+    std::cout << "order '" << order << "' " << done << "\n";
+    return kExitOk;
   }
 };
-
-/// The exit code of a service call that got no reply, after printing why.
-int no_reply(const std::string& vehicle, const Error& error) {
-  std::cerr << "error: vehicle '" << vehicle << "': " << error.message << "\n";
-  return error.code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
-}
 
 int send(const OrderArguments& arguments) {
   msg::OrderRequest request;
@@ -158,32 +188,15 @@ int send(const OrderArguments& arguments) {
     request.destinations().push_back(destination);
   }
   OrderSession<msg::OrderRequest, msg::OrderReply> session;
-  if (const int code = session.open(arguments.dds, logical_agent::kOrderService, request.order(),
-                                    arguments.wait_seconds);
-      code != kExitOk) {
-    return code;
-  }
-  auto reply = session.client->call(request, arguments.dds.timeout(), arguments.vehicle);
-  if (!reply) return no_reply(arguments.vehicle, reply.error());
-  if (auto status = dds::from_wire(reply->error()); !status) {
-    std::cerr << "error: vehicle '" << arguments.vehicle << "' refused order '" << request.order()
-              << "': " << status.error().message << "\n";
-    return kExitFailure;
-  }
+  int code = kExitOk;
+  const auto reply = session.ask(arguments.dds, logical_agent::kOrderService, arguments.vehicle, request,
+                                 request.order(), arguments.wait_seconds,
+                                 "refused order '" + request.order() + "'", code);
+  if (!reply) return code;
   std::cout << "order '" << request.order() << "' queued on '" << arguments.vehicle << "' at position "
             << reply->queue_position() << "\n";
   if (arguments.wait_seconds <= 0) return kExitOk;
-  const auto final_state = session.wait_end(arguments.wait_seconds);
-  if (!final_state) {
-    std::cerr << "error: order '" << request.order() << "' not done within " << arguments.wait_seconds << " s\n";
-    return kExitFailure;
-  }
-  if (final_state->state() != msg::ORDER_FINISHED) {
-    std::cerr << "error: order '" << request.order() << "' " << end_text(*final_state) << "\n";
-    return kExitFailure;
-  }
-  std::cout << "order '" << request.order() << "' finished\n";
-  return kExitOk;
+  return session.await_end(request.order(), arguments.wait_seconds, msg::ORDER_FINISHED, "finished", "not done", "");
 }
 
 int withdraw(const WithdrawArguments& arguments) {
@@ -191,18 +204,11 @@ int withdraw(const WithdrawArguments& arguments) {
   request.order(arguments.order);
   request.reason(arguments.reason);
   OrderSession<msg::OrderWithdrawRequest, msg::OrderWithdrawReply> session;
-  if (const int code = session.open(arguments.dds, logical_agent::kWithdrawService, arguments.order,
-                                    arguments.wait_seconds);
-      code != kExitOk) {
-    return code;
-  }
-  auto reply = session.client->call(request, arguments.dds.timeout(), arguments.vehicle);
-  if (!reply) return no_reply(arguments.vehicle, reply.error());
-  if (auto status = dds::from_wire(reply->error()); !status) {
-    std::cerr << "error: vehicle '" << arguments.vehicle << "' did not withdraw order '" << arguments.order
-              << "': " << status.error().message << "\n";
-    return kExitFailure;
-  }
+  int code = kExitOk;
+  const auto reply = session.ask(arguments.dds, logical_agent::kWithdrawService, arguments.vehicle, request,
+                                 arguments.order, arguments.wait_seconds,
+                                 "did not withdraw order '" + arguments.order + "'", code);
+  if (!reply) return code;
   if (reply->state() == msg::ORDER_WITHDRAWN) {
     std::cout << "order '" << arguments.order << "' withdrawn\n";
     return kExitOk;
@@ -210,18 +216,8 @@ int withdraw(const WithdrawArguments& arguments) {
   std::cout << "order '" << arguments.order << "' being withdrawn: vehicle '" << arguments.vehicle
             << "' stops at the next vertex it can\n";
   if (arguments.wait_seconds <= 0) return kExitOk;
-  const auto final_state = session.wait_end(arguments.wait_seconds);
-  if (!final_state) {
-    std::cerr << "error: order '" << arguments.order << "' not withdrawn within " << arguments.wait_seconds << " s\n";
-    return kExitFailure;
-  }
-  if (final_state->state() != msg::ORDER_WITHDRAWN) {
-    std::cerr << "error: order '" << arguments.order << "' " << end_text(*final_state)
-              << " before it could be withdrawn\n";
-    return kExitFailure;
-  }
-  std::cout << "order '" << arguments.order << "' withdrawn\n";
-  return kExitOk;
+  return session.await_end(arguments.order, arguments.wait_seconds, msg::ORDER_WITHDRAWN, "withdrawn",
+                           "not withdrawn", " before it could be withdrawn");
 }
 
 }  // namespace

@@ -109,8 +109,8 @@ void OrderBook::fail_current(const std::string& reason, TimeNs now) {
 }
 
 Result<OrderState> OrderBook::withdraw(const std::string& name, const std::string& reason, TimeNs now) {
-  const auto found = std::find_if(orders_.begin(), orders_.end(), [&](const Order& o) { return o.name == name; });
-  if (found == orders_.end()) return fail(ErrorCode::not_found, "no order '" + name + "'");
+  Order* found = const_cast<Order*>(find(name));  // find is const; the book is ours to change
+  if (found == nullptr) return fail(ErrorCode::not_found, "no order '" + name + "'");
   Order& order = *found;
   switch (order.state) {
     case OrderState::queued:
