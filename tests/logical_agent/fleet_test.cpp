@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 83..93, 99 and 100. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -911,6 +911,64 @@ TEST_F(FleetTest, VehicleOutOfReachKeepsWhatItWasAllowedOntoUntilItIsSeenStandin
   }
   EXPECT_FALSE(alarm_seen(msg::ALARM_CRITICAL, "V1", "left its allocated area")) << "V1 drove outside what it held";
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+}
+
+// A vehicle that stands where its route planned to leave, and cannot plan on (a lock closes
+// the only way to its destination): the vehicle behind it, due on that vertex next, must
+// not wait for ever. Before, the stranded vehicle's window there ran out, so neither its
+// re-plan nor, once its order failed, a hold of its vertex could be planned (the next
+// vehicle's reservation lay on it), and it retried that hold 20 times a second for ever
+// while the other waited for the vertex it still held.
+TEST_F(FleetTest, VehicleStrandedOnAnothersWayKeepsItsVertexReservedThenClearsTheWay) {
+  constexpr std::uint32_t kDomain = 101;
+  Fleet fleet(kDomain, "stranded");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  fleet.start_vehicle("V1", "left-0", {}, {"--park-after", "-1", "--charge-below", "0", "--route-limit", "6"});
+  fleet.start_vehicle("V2", "left-4");
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "left-4"));
+  ASSERT_EQ(send_order("V1", "v1-stranded", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  // V2 follows V1 over the bar to right-1, after it (V1's route is reserved first).
+  ASSERT_EQ(send_order("V2", "v2-behind", {{"right-1", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.x > 1.0; }))
+      << "V1 never reached the bar";
+
+  // right-3, the only way to right-4, closed for longer than a route may look ahead.
+  auto lock_client = dds::ServiceClient<msg::LockRequest, msg::LockReply>::create(*participant_, "topology", "lock");
+  ASSERT_TRUE(lock_client.has_value());
+  msg::LockRequest lock;
+  lock.entity("right-3");
+  lock.window().start(clock_->now());
+  lock.window().end(clock_->now() + seconds_to_ns(3 * 3600));
+  lock.operator_id("tester");
+  lock.reason("spill");
+  auto locked = (*lock_client)->call(lock, 10s);
+  ASSERT_TRUE(locked.has_value());
+  ASSERT_EQ(locked->error().code(), msg::ERROR_NONE) << locked->error().message();
+
+  // V1 cannot go on: its order fails where it stands, on V2's way.
+  const auto stranded = wait_order("v1-stranded");
+  ASSERT_TRUE(stranded.has_value());
+  EXPECT_EQ(stranded->state(), msg::ORDER_FAILED);
+  // It tells the operator it cannot hold its vertex, drives aside to a parking vertex, and
+  // V2 gets through.
+  const auto behind = wait_order("v2-behind");
+  ASSERT_TRUE(behind.has_value()) << "V2 never got past the stranded V1";
+  EXPECT_EQ(behind->state(), msg::ORDER_FINISHED) << behind->failure();
+  // The nearest parking vertex a route leads to: where V1 stopped on the bar decides which.
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders["right-0"] == "V1" || seen_.holders["left-0"] == "V1"; }, 60s))
+      << "V1 did not clear the way to a parking vertex";
+
+  std::lock_guard guard(seen_.mutex);
+  EXPECT_TRUE(alarm_seen(msg::ALARM_WARNING, "V1", "cannot hold"));
+  EXPECT_EQ(seen_.holders["right-1"], "V2");
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  for (const auto& alarm : seen_.alarms) {
+    EXPECT_NE(alarm.severity(), msg::ALARM_CRITICAL) << alarm.text();
+  }
 }
 
 }  // namespace

@@ -27,6 +27,12 @@ constexpr std::chrono::seconds kStopWait{10};
 constexpr std::chrono::seconds kRanSilence{3};
 /// After a failed attempt to reach a charger, the next one waits this long (shared clock).
 constexpr DurationNs kChargeRetry = seconds_to_ns(30);
+/// A vehicle that cannot hold its vertex keeps it reserved this far ahead (shared clock):
+/// time to drive off once a way is found. Those due after it lose nothing when it leaves
+/// sooner: allocation goes by order, not by time.
+constexpr DurationNs kStrandedReserve = seconds_to_ns(30);
+/// How often (shared clock) a vehicle that cannot hold its vertex tries to clear the way.
+constexpr DurationNs kClearWayRetry = seconds_to_ns(10);
 
 bool nobody_answered(const Error& error) {
   return error.code == ErrorCode::timeout || error.code == ErrorCode::unavailable;
@@ -149,10 +155,7 @@ bool LogicalAgent::hold_position() {
   }
   vertex_ = vertex;
   auto route = plan_route(*vertex, 0, false);
-  if (!route) {
-    spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), route.error().message);
-    return false;
-  }
+  if (!route) return stranded_on(*vertex, route.error().message);
   if (auto switched = switch_route(std::move(*route)); !switched) {
     spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), switched.error().message);
     return false;
@@ -161,6 +164,43 @@ bool LogicalAgent::hold_position() {
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
   release_passed(*status);  // what an earlier route left allocated and the vehicle does not need
   return true;
+}
+
+bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& why) {
+  keep_standing_reserved(vertex, kStrandedReserve);
+  if (!hold_alarm_raised_) {
+    raise_alarm(msg::ALARM_WARNING,
+                fmt::format("vehicle '{}' cannot hold '{}' ({}): it keeps it reserved, so that the vehicles due "
+                            "there wait behind it, and tries to clear the way to a parking vertex",
+                            vehicle_id(), topology_->id(vertex), why));
+    hold_alarm_raised_ = true;
+  } else {
+    spdlog::debug("cannot hold '{}' yet: {}", topology_->id(vertex), why);
+  }
+  if (clock_.now() >= clear_way_at_) {
+    clear_way_at_ = clock_.now() + kClearWayRetry;
+    if (drive_to_nearest(topology::VertexKind::parking, false)) {
+      spdlog::info("vehicle '{}' cleared the way: it holds '{}'", vehicle_id(), topology_->id(*vertex_));
+      return true;
+    }
+  }
+  set_activity(Activity::waiting);
+  std::unique_lock lock(mutex_);
+  wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
+  return false;
+}
+
+void LogicalAgent::keep_standing_reserved(topology::EntityIndex vertex, DurationNs ahead) {
+  const auto granted = monitor_.granted_as(vertex);
+  if (!granted) return;
+  RouteTracker* route = nullptr;
+  if (route_ && route_->id() == granted->route) route = &*route_;
+  if (remnant_ && remnant_->id() == granted->route) route = &*remnant_;
+  if (route == nullptr || granted->step >= route->size() || route->step(granted->step).entity != vertex) return;
+  const TimeNs end = route->step(granted->step).window.end;
+  const TimeNs now = clock_.now();
+  if (end == kForever || end - now > ahead / 2) return;
+  propagate_delay(*route, granted->step, now + ahead - end);
 }
 
 bool LogicalAgent::drivable(const std::vector<topology::RouteStep>& steps) const {
@@ -185,6 +225,9 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
   for (;;) {
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     if (for_order && order_withdrawn()) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
+    // Waiting here (a re-plan after a lock, say), the vehicle stands where its old route
+    // planned to leave: the route asked for starts on that vertex now.
+    keep_standing_reserved(*vertex_, 2 * options_.delay_threshold);
     topology::RouteId id = 0;
     while (id == 0) id = route_ids_();
     msg::RouteRequest request;
@@ -292,6 +335,8 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     wake_.wait_for(lock, options_.tick, [&] { return stopping_.load(); });
   }
   if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
+  remnant_.reset();  // what it held of the vertex is handed over above; the rest is passed
+  hold_alarm_raised_ = false;
   if (next.size() > 1) {
     std::lock_guard lock(mutex_);
     make_way_.reset();  // the vehicle leaves anyway
@@ -305,12 +350,15 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   return {};
 }
 
-Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience) {
+Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience,
+                              std::optional<RouteTracker> planned) {
   drive_activity_ = activity;
   for (;;) {
     if (route_ && route_->arrived() && vertex_ == goal) return {};
     set_activity(activity);
-    auto route = plan_route(goal, patience, activity == Activity::driving);
+    Result<RouteTracker> route =
+        planned ? Result<RouteTracker>(std::move(*planned)) : plan_route(goal, patience, activity == Activity::driving);
+    planned.reset();
     if (!route) {
       // Stranded half-way (a re-plan found nothing): the rest of the old route must not
       // keep blocking others.
@@ -389,7 +437,7 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
       const topology::Point position(status->pose.x, status->pose.y);
       if (auto late = route_->lateness(position, status->linear_speed, options_.vehicle, clock_.now());
           late && *late > options_.delay_threshold) {
-        propagate_delay(route_->position_step(), *late + options_.delay_threshold);
+        propagate_delay(*route_, route_->position_step(), *late + options_.delay_threshold);
       }
     }
     if (route_->arrived() && pending_moves_.empty()) return FollowResult::arrived;
@@ -490,33 +538,36 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
   return std::nullopt;
 }
 
-void LogicalAgent::propagate_delay(std::size_t from_step, DurationNs by) {
-  const auto entity = route_->step(from_step).entity;
-  auto shifts = services_->delay(vehicle_id(), route_->id(), entity, by);
+void LogicalAgent::propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by) {
+  const auto entity = route.step(from_step).entity;
+  auto shifts = services_->delay(vehicle_id(), route.id(), entity, by);
   if (!shifts) {
     spdlog::warn("delay of {} at '{}' not propagated: {}", seconds_text(by), topology_->id(entity),
                  shifts.error().message);
     return;
   }
   for (const auto& shift : *shifts) {
-    if (shift.agent == vehicle_id() && shift.route == route_->id()) {
-      route_->shift(shift.from_step, shift.by);
+    if (shift.agent == vehicle_id() && shift.route == route.id()) {
+      route.shift(shift.from_step, shift.by);
       own_shift_echoes_.insert({shift.route, shift.by});
     }
   }
   spdlog::info("delay of {} propagated from '{}' (step {}): {} route(s) moved", seconds_text(by),
                topology_->id(entity), from_step, shifts->size());
-  // The owners of the rest of the route's partitions move their part too.
+  // The other owners of the route's reservations from that step on move their part too:
+  // those of the step's shadows (its conflicting entities across a border), then those of
+  // the later steps. Each moves everything of the route it holds from there.
   std::set<std::string> partitions{topology_->partition(entity)};
-  for (std::size_t step = from_step + 1; step < route_->size(); ++step) {
-    const auto other = route_->step(step).entity;
-    if (!partitions.insert(topology_->partition(other)).second) continue;
-    auto more = services_->delay(vehicle_id(), route_->id(), other, by);
-    if (!more) continue;
+  const auto delay_where = [&](topology::EntityIndex other) {
+    if (!partitions.insert(topology_->partition(other)).second) return;
+    auto more = services_->delay(vehicle_id(), route.id(), other, by);
+    if (!more) return;
     for (const auto& shift : *more) {
-      if (shift.agent == vehicle_id() && shift.route == route_->id()) own_shift_echoes_.insert({shift.route, shift.by});
+      if (shift.agent == vehicle_id() && shift.route == route.id()) own_shift_echoes_.insert({shift.route, shift.by});
     }
-  }
+  };
+  for (const auto other : topology_->conflicts(entity)) delay_where(other);
+  for (std::size_t step = from_step + 1; step < route.size(); ++step) delay_where(route.step(step).entity);
 }
 
 void LogicalAgent::process_notices(bool& replan) {
@@ -637,6 +688,7 @@ void LogicalAgent::abandon_route() {
     // was allowed onto until hold_position sees it stand again.
     spdlog::warn("vehicle '{}' not known to stand: keeping its {} allocation(s)", vehicle_id(), monitor_.held().size());
   }
+  remnant_ = std::move(route_);
   route_.reset();
 }
 
@@ -745,10 +797,16 @@ bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do
   for (const auto candidate : candidates) {
     if (stopping_) break;
     spdlog::info("{}: trying '{}'", charger ? "going to charge" : "parking", topology_->id(candidate));
-    const auto driven = drive_to(candidate, activity, 0);
+    auto route = plan_route(candidate, 0, false);
+    if (!route) {
+      spdlog::info("no route to '{}' now: {}", topology_->id(candidate), route.error().message);
+      continue;
+    }
+    const auto driven = drive_to(candidate, activity, 0, std::move(*route));
     if (driven) return true;
+    // On the way: an alarm said why, or a re-plan found nothing.
     spdlog::info("'{}' not reached: {}", topology_->id(candidate), driven.error().message);
-    if (!route_) return false;  // the route failed on the way (an alarm was raised)
+    return false;
   }
   return false;
 }

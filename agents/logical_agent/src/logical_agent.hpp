@@ -118,8 +118,23 @@ class LogicalAgent {
   /// Finds the vertex the vehicle stands on and holds it with a route to itself (once a
   /// recent status shows it standing, after cancelling moves the RAN may still run), then
   /// releases what earlier routes left allocated that the vehicle does not need.
-  /// \return whether it holds one now.
+  /// Where that vertex cannot be held (another vehicle is due there next, or it is locked):
+  /// see stranded_on. \return whether it holds one now.
   bool hold_position();
+  /// The vehicle stands on `vertex` and cannot hold it (`why`): it keeps the vertex reserved
+  /// ahead of now (keep_standing_reserved), so that the vehicles due there wait behind it
+  /// and none is given the vertex under it, tells the operator once (a warning), and now
+  /// and then tries to clear the way to a parking vertex. Pauses before returning, so that
+  /// the executor asks the routing agent a few times a second at most.
+  /// \return whether the vehicle holds a vertex now (it cleared the way).
+  bool stranded_on(topology::EntityIndex vertex, const std::string& why);
+  /// While the vehicle stands on `vertex` under a route step with a bounded window (it
+  /// waits for a route there, or cannot hold it), that window must not run out: the next
+  /// vehicle due there would be planned onto the vertex under it, and this vehicle could
+  /// plan no route from it. Once the window would end within `ahead` / 2, it is delayed
+  /// (I3: those due after it move back in order) to end `ahead` from now. Nothing for an
+  /// open-ended hold, or a vertex not held under a known route.
+  void keep_standing_reserved(topology::EntityIndex vertex, DurationNs ahead);
   std::optional<topology::EntityIndex> vertex_under(const ran::VehicleStatus& status) const;
   /// A real route from the vehicle's vertex to `goal`, retried (within route_limit) while
   /// it is blocked. \return the route or why none.
@@ -134,10 +149,12 @@ class LogicalAgent {
   /// Makes `next` the current route: swaps the vertex the vehicle holds onto it, cancels
   /// the previous route.
   Status switch_route(RouteTracker next);
-  /// Drives to `goal` (re-planning on locks). \return success, or why it failed.
+  /// Drives to `goal` (re-planning on locks), along `planned` first when given (a route to
+  /// `goal` from the vehicle's vertex, just reserved). \return success, or why it failed.
   /// Activity::driving drives for the running order: a withdrawal of the order stops it
   /// (not_permitted) where the vehicle stands once its commanded moves are done.
-  Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience);
+  Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience,
+                  std::optional<RouteTracker> planned = std::nullopt);
   FollowResult follow(std::string& failure);
   /// Performs an action where the vehicle stands. \return success or why it failed.
   Status operate(const ran::ActionCommand& action, Activity activity);
@@ -147,8 +164,9 @@ class LogicalAgent {
   /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
   void go_to_service_vertex(topology::VertexKind kind);
   /// Drives to the nearest vertex of `kind` other than the one the vehicle stands on (or,
-  /// with `here_will_do`, stays where it is when that is of `kind`).
-  /// \return whether it stands on one now.
+  /// with `here_will_do`, stays where it is when that is of `kind`): the nearest one a route
+  /// leads to now (one try each).
+  /// \return whether it stands on one now (false also when the drive failed on the way).
   bool drive_to_nearest(topology::VertexKind kind, bool here_will_do);
 
   // ---- making way (make_way.cpp) ----
@@ -163,13 +181,17 @@ class LogicalAgent {
   bool make_way(const std::string& requester);
   /// Gives up the current route after a failure: stops the vehicle, cancels the route's
   /// reservations but for the steps it holds, and, once the vehicle is known to stand,
-  /// releases what the footprint does not need (otherwise hold_position does, later).
+  /// releases what the footprint does not need (otherwise hold_position does, later). The
+  /// route becomes remnant_.
   void abandon_route();
   /// Cancels a route of ours on every topology agent; failures are logged.
   void cancel_route_quietly(topology::RouteId route);
   void release_passed(const ran::VehicleStatus& status);
   void process_notices(bool& replan);
-  void propagate_delay(std::size_t from_step, DurationNs by);
+  /// Delays `route` (route_ or remnant_) by `by` from its step `from_step` on, on every
+  /// topology agent that owns a reservation of it from there: the step's own, those that
+  /// hold its shadows (conflicting entities across a border) and those of the later steps.
+  void propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by);
   /// Cancels the moves the RAN has not ended and waits (bounded) for a status after the
   /// cancel showing the vehicle still. \return whether it is known to stand with nothing
   /// commanded; false when the cancel did not reach the RAN (the moves stay pending, the
@@ -210,6 +232,12 @@ class LogicalAgent {
   // Executor state.
   FootprintMonitor monitor_;
   std::optional<RouteTracker> route_;
+  /// The route abandon_route gave up last, until the next route begins: the vehicle may
+  /// still hold steps of it (the vertex it stands on), whose windows keep_standing_reserved
+  /// keeps ahead of now. Notices about it are not followed: another's delay can only make
+  /// its windows longer, so the windows here are at most as long as the timelines' (a
+  /// delay asked for from them moves it a little further than needed, never too little).
+  std::optional<RouteTracker> remnant_;
   std::deque<std::pair<ran::CommandId, std::size_t>> pending_moves_;  ///< id, target step
   std::optional<topology::EntityIndex> vertex_;  ///< where the vehicle stands or last stood
   Activity activity_ = Activity::idle;
@@ -224,6 +252,8 @@ class LogicalAgent {
   std::optional<TimeNs> stop_asked_;
   bool stop_undelivered_ = false;  ///< a cancel did not reach the RAN (warned once)
   bool position_alarm_raised_ = false;
+  bool hold_alarm_raised_ = false;  ///< stranded_on told the operator (until a hold again)
+  TimeNs clear_way_at_ = 0;         ///< when stranded_on tries to clear the way next
   bool making_way_ = false;                          ///< driving aside: requests wait
   std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked
   std::string command_prefix_;
