@@ -1,20 +1,15 @@
 #include "drover/launcher/fleet_monitor.hpp"
 
-#include <cmath>
-
 #include "agents/topology_agent/topology_agent.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
+#include "drover/ran/status.hpp"
 #include "drover/ran_runner/names.hpp"
 #include "ran_status_message.hpp"
 
 namespace drover::launcher {
 
 namespace {
-
-/// Speeds below these count as standing (m/s, rad/s).
-constexpr double kMovingLinear = 1e-3;
-constexpr double kMovingAngular = 1e-3;
 
 std::optional<TimeNs> time_of(const msg::OptionalTime& time) {
   return time.present() ? std::optional<TimeNs>(time.ns()) : std::nullopt;
@@ -133,8 +128,7 @@ void FleetMonitor::on_status(const msg::RanStatus& status) {
   if (trace_ != nullptr) trace_->write(status.time().ns(), "ran_status", status_line(status));
   std::lock_guard lock(mutex_);
   ++statuses_;
-  moving_[status.vehicle_id()] = std::abs(status.linear_speed()) > kMovingLinear ||
-                                 std::abs(status.angular_speed()) > kMovingAngular;
+  moving_[status.vehicle_id()] = !ran::standing_still(status.linear_speed(), status.angular_speed());
 }
 
 void FleetMonitor::on_progress(const msg::OrderProgress& progress) {

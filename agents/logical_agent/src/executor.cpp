@@ -663,8 +663,7 @@ bool LogicalAgent::stop_vehicle() {
 }
 
 bool LogicalAgent::fresh_and_standing(TimeNs since) const {
-  return status_ && status_->time > since && std::abs(status_->linear_speed) < 1e-3 &&
-         std::abs(status_->angular_speed) < 1e-3;
+  return status_ && status_->time > since && ran::standing_still(status_->linear_speed, status_->angular_speed);
 }
 
 void LogicalAgent::cancel_route_quietly(topology::RouteId route) {

@@ -310,7 +310,7 @@ void LogicalAgent::publish_vehicle_state(bool force) {
     state.queued_orders(static_cast<std::uint32_t>(book_.queued_count()));
     if (status_) {
       state.state_of_charge(status_->battery.state_of_charge);
-      state.moving(std::abs(status_->linear_speed) > 0.01 || std::abs(status_->angular_speed) > 0.01);
+      state.moving(!ran::standing_still(status_->linear_speed, status_->angular_speed));
     }
   }
   const auto real_now = std::chrono::steady_clock::now();

@@ -3,6 +3,7 @@
 // that sees only the latest one (DDS state topics keep the last sample) still learns how
 // every recent command ended, because ended commands stay in the snapshot for a while.
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -61,6 +62,15 @@ struct BatteryStatus {
 
   friend bool operator==(const BatteryStatus&, const BatteryStatus&) = default;
 };
+
+/// Speeds at or below these count as standing still (m/s, rad/s). One rule for everyone who
+/// asks whether a vehicle moves: the logical agent waiting for a cancelled vehicle to stand,
+/// its published VehicleState.moving, and the launcher's fleet monitor.
+inline constexpr double kStandingLinearSpeed = 1e-3;
+inline constexpr double kStandingAngularSpeed = 1e-3;
+inline bool standing_still(double linear_speed, double angular_speed) noexcept {
+  return std::abs(linear_speed) <= kStandingLinearSpeed && std::abs(angular_speed) <= kStandingAngularSpeed;
+}
 
 struct VehicleStatus {
   std::string vehicle_id;
