@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <boost/geometry/algorithms/covered_by.hpp>
 #include <fmt/format.h>
 
 namespace drover::ran {
@@ -110,11 +111,17 @@ CommandCheck check_against_topology(const MoveCommand& command, const topology::
                   fmt::format("{}: edge '{}' does not lead to vertex '{}'", where, edge.id, vertex.id));
   }
   const topology::Vertex& origin = topology.vertex(*from);
-  if (distance_to_segment(start.x, start.y, origin.position, vertex.position) >
-      position_tolerance) {
+  // A vehicle that braked to a stop a little past a vertex (a cancel) stands on it as far as
+  // its commander can tell (inside its footprint), but on the edge it came by: moves from
+  // that vertex over another edge start there. Whether the way from there to the target
+  // stays inside the motion area is the driver's check (outside_area).
+  const bool on_edge =
+      distance_to_segment(start.x, start.y, origin.position, vertex.position) <= position_tolerance;
+  if (!on_edge &&
+      !boost::geometry::covered_by(topology::Point(start.x, start.y), topology.footprint(*from))) {
     return reject(kEdgeMismatch,
                   fmt::format("{}: edge '{}' runs from vertex '{}' ({}, {}), but the move starts "
-                              "at ({}, {}), off the edge",
+                              "at ({}, {}), off the edge and outside the vertex's footprint",
                               where, edge.id, origin.id, origin.position.x(), origin.position.y(),
                               start.x, start.y));
   }

@@ -898,6 +898,11 @@ TEST_F(FleetTest, VehicleOutOfReachKeepsWhatItWasAllowedOntoUntilItIsSeenStandin
       },
       60s))
       << "V1 does not hold exactly the vertex it stands on";
+  // From where it braked (often a little past that vertex) it takes new work.
+  ASSERT_EQ(send_order("V1", "v1-home", {{"left-0", "NOP"}}), "");
+  const auto home = wait_order("v1-home");
+  ASSERT_TRUE(home.has_value());
+  EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
 
   std::lock_guard lock(seen_.mutex);
   const auto& times = seen_.status_times["V1"];

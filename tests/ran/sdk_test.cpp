@@ -62,7 +62,7 @@ TEST(MotionArea, TranslationSweepCoversTheWayBetween) {
   EXPECT_GT(area_outside(swept, area), 0.9);
 }
 
-TEST(Validation, CheckAgainstTopologyAcceptsAStartPartWayAlongTheEdge) {
+TEST(Validation, CheckAgainstTopologyAcceptsAStartAlongTheEdgeOrOnItsOriginVertex) {
   const auto world = test::world();
   const auto command = test::move(*world, "m", "B", "bc", "C", 1.0);
   EXPECT_TRUE(check_against_topology(command, *world, Pose{5, 0, 0}, 0.01));
@@ -70,6 +70,13 @@ TEST(Validation, CheckAgainstTopologyAcceptsAStartPartWayAlongTheEdge) {
   const auto off = check_against_topology(command, *world, Pose{7.5, 0.5, 0}, 0.01);
   ASSERT_FALSE(off);
   EXPECT_EQ(off.error().code, rejection_code::kEdgeMismatch);
+  // Driving west from C, braked to a stop 0.3 m past B, on ab: it stands on B (inside its
+  // footprint, a 1 m square), so a move from B over bc starts there. Beyond the footprint,
+  // off bc, it does not.
+  EXPECT_TRUE(check_against_topology(command, *world, Pose{4.7, 0, std::numbers::pi}, 0.01));
+  const auto beyond = check_against_topology(command, *world, Pose{4.3, 0, std::numbers::pi}, 0.01);
+  ASSERT_FALSE(beyond);
+  EXPECT_EQ(beyond.error().code, rejection_code::kEdgeMismatch);
   // A turn on the spot (no edge) must start at the target.
   auto turn = test::move(*world, "t", "C", "", "C", 1.0, 1.0);
   EXPECT_TRUE(check_against_topology(turn, *world, Pose{10, 0, 0}, 0.01));

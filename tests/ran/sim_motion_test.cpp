@@ -43,6 +43,31 @@ TEST(SimMotion, ReachesTheTargetInTrapezoidTime) {
   EXPECT_EQ(status.linear_speed, 0.0);
 }
 
+// After a cancel a vehicle brakes to a stop where it is, often a little past the vertex it
+// was nearing, on the next edge. Its commander takes it to stand on that vertex (inside its
+// footprint) and sends the next route's first move from there, over any edge: the vehicle
+// takes it and drives to the target inside the motion area (before, it refused the move as
+// starting off the edge, and every later route failed the same way).
+TEST(SimMotion, StartsAMoveFromAVertexItStoppedALittlePast) {
+  const auto world = test::world();
+  // Came from C westwards, stopped 0.1 m past B, on ab.
+  auto created = SimVehicle::create({}, Pose{4.9, 0, std::numbers::pi}, 0, world);
+  ASSERT_TRUE(created.has_value()) << created.error().message;
+  auto vehicle = std::move(*created);
+  const auto taken = vehicle.submit(move(*world, "m1", "B", "bc", "C", 1.0));
+  ASSERT_TRUE(taken) << taken.error().reason;
+  finish_time(vehicle, "m1");
+  EXPECT_DOUBLE_EQ(vehicle.status().pose.x, 10.0);
+  EXPECT_DOUBLE_EQ(vehicle.status().pose.y, 0.0);
+  // 0.3 m past B, turning there would sweep out of B's footprint (the motion area holds B,
+  // bc and C): that is still refused.
+  auto further = SimVehicle::create({}, Pose{4.7, 0, std::numbers::pi}, 0, world);
+  ASSERT_TRUE(further.has_value());
+  const auto refused = further->submit(move(*world, "m1", "B", "bc", "C", 1.0));
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, rejection_code::kOutsideArea);
+}
+
 TEST(SimMotion, UsesTheLowerOfCommandAndVehicleSpeed) {
   const auto world = test::world();
   SimVehicleConfig config;

@@ -49,9 +49,11 @@ CommandCheck validate(const ActionCommand& command);
 ///  - the target vertex exists and `command.target` lies within `position_tolerance` metres
 ///    of its position;
 ///  - a non-empty edge exists, ends at the target vertex and may be driven towards it, and
-///    `start` (where the move begins) lies on it within `position_tolerance`: normally at
+///    `start` (where the move begins) lies on it within `position_tolerance` (normally at
 ///    its other end, or part-way along it when an earlier move was cancelled or paused
-///    there; the command's max speed does not exceed the edge's;
+///    there) or inside the footprint of its other end (a vehicle that braked to a stop a
+///    little past that vertex, onto another edge); the command's max speed does not exceed
+///    the edge's;
 ///  - an empty edge means a turn on the spot: `start` must be at the target vertex.
 /// \param start  where the vehicle is when the move begins (the end of the previous move).
 CommandCheck check_against_topology(const MoveCommand& command, const topology::Topology& topology,
