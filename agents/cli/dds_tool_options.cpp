@@ -10,9 +10,11 @@ void add_dds_tool_options(CLI::App& command, DdsToolOptions& options, double def
   options.timeout_seconds = default_timeout_seconds;
   command.add_option("--domain", options.domain_id, "DDS domain id of the agents (default 0)")
       ->transform(cli::whole_in(0, 232));
-  command.add_option("--timeout", options.timeout_seconds, "Seconds to wait for agents to answer")
-      ->transform(cli::positive())
-      ->capture_default_str();
+  if (default_timeout_seconds > 0) {
+    command.add_option("--timeout", options.timeout_seconds, "Seconds to wait for agents to answer")
+        ->transform(cli::positive())
+        ->capture_default_str();
+  }
   command.add_option("--xml-profile", options.xml_profile, "Fast DDS XML profiles file (transports, security)")
       ->check(CLI::ExistingFile);
 }

@@ -24,7 +24,9 @@ struct DdsToolOptions {
   }
 };
 
-/// Adds --domain, --timeout (seconds, how long to wait for agents) and --xml-profile.
+/// Adds --domain, --timeout (seconds, how long to wait for agents, default
+/// `default_timeout_seconds`; not added when that is 0: a command that waits for no
+/// answer) and --xml-profile.
 void add_dds_tool_options(CLI::App& command, DdsToolOptions& options, double default_timeout_seconds);
 
 /// The tool's participant. \return it, or the participant's error (invalid_argument for

@@ -25,4 +25,9 @@ void add_lock_command(CLI::App& app, CommandContext& context);
 void add_unlock_command(CLI::App& app, CommandContext& context);
 void add_timeline_command(CLI::App& app, CommandContext& context);
 
+/// `droverctl vehicles`: what every vehicle is doing, from its logical agent's state;
+/// `droverctl alarms`: follows the operator alarms as they are raised.
+void add_vehicles_command(CLI::App& app, CommandContext& context);
+void add_alarms_command(CLI::App& app, CommandContext& context);
+
 }  // namespace drover::cli

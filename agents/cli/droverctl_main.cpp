@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   add_unlock_command(app, context);
   add_timeline_command(app, context);
   add_order_command(app, context);
+  add_vehicles_command(app, context);
+  add_alarms_command(app, context);
   add_route_command(app, context);
 
   return run_app(app, context, argc, argv);

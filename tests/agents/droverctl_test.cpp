@@ -1,13 +1,24 @@
-// `droverctl agents` as an operator runs it: a separate process against live agents.
+// droverctl as an operator runs it, a separate process: `agents`, `vehicles` and `alarms`
+// against live agents (dds_test_peer processes, or participants of the test process that
+// publish as logical agents do), and its bad usage. Domains 40..44.
+
+#include <signal.h>
 
 #include <chrono>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "drover/dds/agent_directory.hpp"
+#include "drover/dds/heartbeat_publisher.hpp"
+#include "drover/dds/writer.hpp"
+#include "drover/logical_agent/messages.hpp"
+#include "drover/logical_agent/names.hpp"
 #include "tests/agents/dds_test_support.hpp"
 
 namespace drover::test {
@@ -85,6 +96,140 @@ TEST_F(DroverctlTest, AgentsExitsWithCode3WhenNobodyAnswers) {
   EXPECT_TRUE(out.empty()) << out;
 }
 
+/// A logical agent as droverctl sees one: its heartbeat, and its vehicle's state.
+struct FakeLogicalAgent {
+  std::unique_ptr<dds::Participant> participant;
+  std::unique_ptr<dds::HeartbeatPublisher> heartbeat;
+  std::unique_ptr<dds::Writer<msg::VehicleState>> states;
+
+  FakeLogicalAgent(std::uint32_t domain, const msg::VehicleState& state) {
+    participant = make_participant(domain, state.vehicle());
+    if (!participant) return;
+    dds::HeartbeatOptions beat;
+    beat.kind = "logical";
+    beat.owns = {state.vehicle()};
+    auto created = dds::HeartbeatPublisher::create(*participant, SharedClock::wall(), beat);
+    EXPECT_TRUE(created.has_value());
+    if (created) heartbeat = std::move(*created);
+    auto writer = dds::Writer<msg::VehicleState>::create(*participant, logical_agent::kVehicleStateTopic);
+    EXPECT_TRUE(writer.has_value());
+    if (!writer) return;
+    states = std::move(*writer);
+    EXPECT_TRUE(states->write(state).has_value());
+  }
+  ~FakeLogicalAgent() {
+    states.reset();
+    heartbeat.reset();
+  }
+};
+
+msg::VehicleState vehicle_state(const std::string& vehicle, msg::VehicleActivity activity, const std::string& vertex,
+                                const std::string& order, double state_of_charge, bool moving) {
+  msg::VehicleState state;
+  state.vehicle(vehicle);
+  state.ran("ran-" + vehicle);
+  state.state(activity);
+  state.vertex(vertex);
+  state.order(order);
+  state.queued_orders(order.empty() ? 0 : 2);
+  state.state_of_charge(state_of_charge);
+  state.moving(moving);
+  state.time().ns(seconds_to_ns(1000));
+  return state;
+}
+
+TEST_F(DroverctlTest, VehiclesShowsWhatEveryVehicleIsDoing) {
+  constexpr std::uint32_t kDomain = 42;
+  FakeLogicalAgent v1(kDomain, vehicle_state("V1", msg::VEHICLE_DRIVING, "aisle-3", "o-17", 0.8, true));
+  FakeLogicalAgent v2(kDomain, vehicle_state("V2", msg::VEHICLE_CHARGING, "charger-1", "", 0.15, false));
+  ASSERT_TRUE(v1.states && v2.states);
+
+  std::string out, err;
+  auto status = run_droverctl({"vehicles", "--domain", std::to_string(kDomain), "--json", "--timeout", "30"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  ASSERT_EQ(status->code, 0) << err;
+  const auto listed = nlohmann::json::parse(out);
+  ASSERT_EQ(listed.size(), 2u) << out;
+  EXPECT_EQ(listed[0]["vehicle"], "V1");
+  EXPECT_EQ(listed[0]["state"], "driving");
+  EXPECT_EQ(listed[0]["vertex"], "aisle-3");
+  EXPECT_EQ(listed[0]["order"], "o-17");
+  EXPECT_EQ(listed[0]["queued_orders"], 2);
+  EXPECT_EQ(listed[0]["moving"], true);
+  EXPECT_DOUBLE_EQ(listed[0]["state_of_charge"].get<double>(), 0.8);
+  EXPECT_EQ(listed[1]["vehicle"], "V2");
+  EXPECT_EQ(listed[1]["state"], "charging");
+  EXPECT_EQ(listed[1]["order"], "");
+
+  status = run_droverctl({"vehicles", "--domain", std::to_string(kDomain), "--timeout", "30"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  ASSERT_EQ(status->code, 0) << err;
+  EXPECT_NE(out.find("VEHICLE"), std::string::npos) << out;
+  EXPECT_NE(out.find("charging  charger-1"), std::string::npos) << out;
+  EXPECT_NE(out.find("15 %"), std::string::npos) << out;
+}
+
+TEST_F(DroverctlTest, VehiclesExitsWithCode3WhenNoLogicalAgentAnswers) {
+  std::string out, err;
+  auto status = run_droverctl({"vehicles", "--domain", "43", "--timeout", "0.5"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 3);
+  EXPECT_NE(err.find("no logical agent answered on domain 43 within 0.5 s"), std::string::npos) << err;
+}
+
+TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm) {
+  constexpr std::uint32_t kDomain = 44;
+  auto agent = make_participant(kDomain, "V1");
+  ASSERT_TRUE(agent);
+  auto writer = dds::Writer<msg::OperatorAlarm>::create(*agent, logical_agent::kAlarmTopic, dds::TopicQos::events());
+  ASSERT_TRUE(writer.has_value());
+
+  const std::string out_file = ::testing::TempDir() + "droverctl_alarms.out";
+  const std::string err_file = ::testing::TempDir() + "droverctl_alarms.err";
+  auto child = ChildProcess::spawn(binary_path("droverctl"),
+                                   {"alarms", "--domain", std::to_string(kDomain), "--min-severity", "warning",
+                                    "--json"},
+                                   out_file, err_file);
+  ASSERT_TRUE(child.has_value());
+  children_.push_back(std::move(*child));
+  // Alarms are events: only those written once droverctl's reader matched reach it.
+  ASSERT_TRUE((*writer)->wait_for_readers(1, kDiscoveryTimeout));
+  const auto alarm = [](msg::AlarmSeverity severity, const std::string& text) {
+    msg::OperatorAlarm a;
+    a.agent("V1");
+    a.vehicle("V1");
+    a.severity(severity);
+    a.text(text);
+    a.time().ns(seconds_to_ns(12.5));
+    return a;
+  };
+  ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_INFO, "route re-planned")).has_value());
+  ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_CRITICAL, "left its allocated area")).has_value());
+
+  // The critical one shows (written after the info one, on a reliable topic: that one
+  // arrived first and was left out).
+  std::string out;
+  const auto deadline = std::chrono::steady_clock::now() + kDiscoveryTimeout;
+  while (out.find("left its allocated area") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    out = read_file(out_file);
+  }
+  children_.back().signal(SIGTERM);
+  const auto status = children_.back().wait_exit(30s);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_TRUE(status->exited && status->code == 0) << read_file(err_file);
+  out = read_file(out_file);
+  std::istringstream lines(out);
+  std::string line;
+  std::vector<nlohmann::json> shown;
+  while (std::getline(lines, line)) shown.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(shown.size(), 1u) << out;
+  EXPECT_EQ(shown[0]["severity"], "critical");
+  EXPECT_EQ(shown[0]["vehicle"], "V1");
+  EXPECT_EQ(shown[0]["text"], "left its allocated area");
+  EXPECT_EQ(shown[0]["time_ns"], seconds_to_ns(12.5));
+}
+
 TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
   std::string out, err;
   auto status = run_droverctl({"agents", "--domain", "999"}, out, err);
@@ -106,6 +251,16 @@ TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 2);
   EXPECT_NE(err.find("--wait"), std::string::npos) << err;
+
+  status = run_droverctl({"alarms", "--min-severity", "loud"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("--min-severity 'loud'"), std::string::npos) << err;
+
+  status = run_droverctl({"alarms", "--duration", "-1"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("--duration"), std::string::npos) << err;
 }
 
 }  // namespace

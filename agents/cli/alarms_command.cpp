@@ -1,0 +1,117 @@
+// `droverctl alarms [--domain N] [--min-severity S] [--duration S] [--json]`: follows the
+// operator alarms of a domain (drover/operator/alarm) as they are raised, one line each,
+// until Ctrl-C, SIGTERM or the end of --duration. Alarms are events: those raised before
+// it started are not shown.
+
+#include <chrono>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "agents/cli/dds_tool_options.hpp"
+#include "agents/cli/droverctl_commands.hpp"
+#include "drover/common/clock.hpp"
+#include "drover/dds/reader.hpp"
+#include "drover/dds/shutdown_signal.hpp"
+#include "drover/logical_agent/messages.hpp"
+#include "drover/logical_agent/names.hpp"
+#include "drover/logical_agent/wire_names.hpp"
+
+namespace drover::cli {
+namespace {
+
+struct AlarmsArguments {
+  DdsToolOptions dds;
+  std::string min_severity = "info";
+  double duration_seconds = 0;  ///< 0: until a signal
+  bool json = false;
+};
+
+/// One alarm as a line: "<shared-clock seconds> <SEVERITY> <vehicle or agent>: <text>", or
+/// a JSON object.
+std::string alarm_line(const msg::OperatorAlarm& alarm, bool json) {
+  const std::string severity(logical_agent::severity_name(alarm.severity()));
+  if (json) {
+    return nlohmann::json{{"time_ns", alarm.time().ns()},
+                          {"agent", alarm.agent()},
+                          {"vehicle", alarm.vehicle()},
+                          {"severity", severity},
+                          {"text", alarm.text()}}
+        .dump();
+  }
+  std::ostringstream line;
+  line << std::fixed << std::setprecision(3) << ns_to_seconds(alarm.time().ns()) << " " << severity << " "
+       << (alarm.vehicle().empty() ? alarm.agent() : alarm.vehicle()) << ": " << alarm.text();
+  return line.str();
+}
+
+int run_alarms(const AlarmsArguments& arguments) {
+  const auto minimum = logical_agent::severity_from_name(arguments.min_severity);
+  if (!minimum) {
+    std::cerr << "error: --min-severity '" << arguments.min_severity
+              << "': expected info, warning, error or critical\n";
+    return kExitBadInput;
+  }
+  if (auto installed = dds::install_shutdown_handlers(); !installed) {
+    std::cerr << "error: " << installed.error().message << "\n";
+    return kExitFailure;
+  }
+  auto participant = open_tool_participant(arguments.dds);
+  if (!participant) {
+    std::cerr << "error: " << participant.error().message << "\n";
+    return participant.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
+  }
+  std::mutex output;  // alarms arrive on the reader's thread
+  bool write_failed = false;
+  dds::ReaderOptions events;
+  events.qos = dds::TopicQos::events();
+  auto reader = dds::Reader<msg::OperatorAlarm>::create(
+      **participant, logical_agent::kAlarmTopic,
+      [&](const msg::OperatorAlarm& alarm) {
+        if (alarm.severity() < *minimum) return;
+        std::lock_guard lock(output);
+        // Flushed line by line: a follower piped into another tool sees each at once.
+        std::cout << alarm_line(alarm, arguments.json) << std::endl;
+        write_failed = write_failed || !std::cout;
+      },
+      events);
+  if (!reader) {
+    std::cerr << "error: " << reader.error().message << "\n";
+    return kExitFailure;
+  }
+  std::cerr << "following alarms on domain " << arguments.dds.domain_id << " (Ctrl-C to stop)\n";
+  if (arguments.duration_seconds > 0) {
+    dds::wait_for_shutdown(std::chrono::milliseconds(static_cast<std::int64_t>(arguments.duration_seconds * 1000)));
+  } else {
+    dds::wait_for_shutdown();
+  }
+  reader->reset();  // no callback after this
+  if (write_failed) {
+    std::cerr << "error: cannot write to standard output\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_alarms_command(CLI::App& app, CommandContext& context) {
+  auto arguments = std::make_shared<AlarmsArguments>();
+  auto* command = app.add_subcommand(
+      "alarms", "Follow the operator alarms as they are raised, one line each, until Ctrl-C or --duration");
+  add_dds_tool_options(*command, arguments->dds, 0);
+  command->add_option("--min-severity", arguments->min_severity,
+                      "Show alarms of this severity and above: info, warning, error, critical (default info)");
+  command->add_option("--duration", arguments->duration_seconds, "Stop after S seconds (default: at Ctrl-C)")
+      ->transform(cli::non_negative());
+  command->add_flag("--json", arguments->json, "One JSON object per alarm instead of text");
+  command->callback([arguments, &context] { context.exit_code = run_alarms(*arguments); });
+}
+
+}  // namespace drover::cli

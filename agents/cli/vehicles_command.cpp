@@ -1,0 +1,158 @@
+// `droverctl vehicles [--domain N] [--timeout S] [--json]`: what every vehicle of a domain
+// is doing, from the state its logical agent publishes (drover/logical/vehicle, kept for
+// late joiners): activity, vertex, order, queue, motion, battery. Exit 3 when no logical
+// agent answers within the timeout.
+
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "agents/cli/agent_discovery.hpp"
+#include "agents/cli/dds_tool_options.hpp"
+#include "agents/cli/droverctl_commands.hpp"
+#include "drover/dds/agent_directory.hpp"
+#include "drover/dds/reader.hpp"
+#include "drover/logical_agent/messages.hpp"
+#include "drover/logical_agent/names.hpp"
+#include "drover/logical_agent/wire_names.hpp"
+
+namespace drover::cli {
+namespace {
+
+struct VehiclesArguments {
+  DdsToolOptions dds;
+  bool json = false;
+};
+
+/// The latest state of each vehicle, as it arrives.
+class VehicleStates {
+ public:
+  void on_state(const msg::VehicleState& state) {
+    std::lock_guard lock(mutex_);
+    states_[state.vehicle()] = state;
+  }
+  std::map<std::string, msg::VehicleState> states() const {
+    std::lock_guard lock(mutex_);
+    return states_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, msg::VehicleState> states_;
+};
+
+/// Whether a state arrived from every live logical agent (their heartbeats name the
+/// vehicle they own), and from one at least.
+bool every_vehicle_seen(const std::vector<dds::AgentRecord>& agents,
+                        const std::map<std::string, msg::VehicleState>& states) {
+  if (states.empty()) return false;
+  return std::all_of(agents.begin(), agents.end(), [&](const dds::AgentRecord& agent) {
+    if (agent.kind != "logical" || !agent.alive) return true;
+    return std::all_of(agent.owns.begin(), agent.owns.end(),
+                       [&](const std::string& vehicle) { return states.count(vehicle) != 0; });
+  });
+}
+
+std::string battery_text(double state_of_charge) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(0) << state_of_charge * 100 << " %";
+  return out.str();
+}
+
+void print_table(const std::map<std::string, msg::VehicleState>& states) {
+  const std::vector<std::string> header{"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY"};
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& [vehicle, state] : states) {
+    rows.push_back({vehicle, std::string(logical_agent::activity_name(state.state())), state.vertex().empty() ? "-" : state.vertex(),
+                    state.order().empty() ? "-" : state.order(), std::to_string(state.queued_orders()),
+                    state.moving() ? "yes" : "no", battery_text(state.state_of_charge())});
+  }
+  std::vector<std::size_t> widths(header.size());
+  for (std::size_t i = 0; i < header.size(); ++i) widths[i] = header[i].size();
+  for (const auto& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], row[i].size());
+  }
+  const auto print_row = [&](const std::vector<std::string>& row) {
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      std::cout << row[i] << (i + 1 < row.size() ? std::string(widths[i] - row[i].size() + 2, ' ') : "\n");
+    }
+  };
+  print_row(header);
+  for (const auto& row : rows) print_row(row);
+}
+
+void print_json(const std::map<std::string, msg::VehicleState>& states) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [vehicle, state] : states) {
+    out.push_back({{"vehicle", vehicle},
+                   {"ran", state.ran()},
+                   {"state", std::string(logical_agent::activity_name(state.state()))},
+                   {"vertex", state.vertex()},
+                   {"order", state.order()},
+                   {"queued_orders", state.queued_orders()},
+                   {"moving", state.moving()},
+                   {"state_of_charge", state.state_of_charge()},
+                   {"time_ns", state.time().ns()}});
+  }
+  std::cout << out.dump() << "\n";
+}
+
+int run_vehicles(const VehiclesArguments& arguments) {
+  auto participant = open_tool_participant(arguments.dds);
+  if (!participant) {
+    std::cerr << "error: " << participant.error().message << "\n";
+    return participant.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
+  }
+  VehicleStates collected;
+  auto reader = dds::Reader<msg::VehicleState>::create(
+      **participant, logical_agent::kVehicleStateTopic,
+      [&collected](const msg::VehicleState& state) { collected.on_state(state); });
+  if (!reader) {
+    std::cerr << "error: " << reader.error().message << "\n";
+    return kExitFailure;
+  }
+  // Every logical agent present is discovered as `droverctl agents` does it, and has shown
+  // its vehicle's state; never past the timeout.
+  const auto agents = discover_live_agents(**participant, arguments.dds.timeout(), [&](const auto& records) {
+    return every_vehicle_seen(records, collected.states());
+  });
+  if (!agents) {
+    std::cerr << "error: " << agents.error().message << "\n";
+    return kExitFailure;
+  }
+  const auto states = collected.states();
+  reader->reset();  // before `collected`, which its callback fills
+  if (states.empty()) {
+    std::cerr << "error: no logical agent answered on domain " << arguments.dds.domain_id << " within "
+              << arguments.dds.timeout_seconds << " s\n";
+    return kExitNoAnswer;
+  }
+  if (arguments.json) {
+    print_json(states);
+  } else {
+    print_table(states);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_vehicles_command(CLI::App& app, CommandContext& context) {
+  auto arguments = std::make_shared<VehiclesArguments>();
+  auto* command = app.add_subcommand(
+      "vehicles", "What every vehicle is doing: activity, vertex, order, queue, motion, battery (from its logical agent)");
+  add_dds_tool_options(*command, arguments->dds, 2.0);
+  command->add_flag("--json", arguments->json, "Print a JSON array instead of a table");
+  command->callback([arguments, &context] { context.exit_code = run_vehicles(*arguments); });
+}
+
+}  // namespace drover::cli
