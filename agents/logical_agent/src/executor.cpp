@@ -154,20 +154,28 @@ bool LogicalAgent::hold_position() {
     return false;
   }
   vertex_ = vertex;
-  auto route = plan_route(*vertex, 0, false);
-  if (!route) return stranded_on(*vertex, route.error().message);
-  if (auto switched = switch_route(std::move(*route)); !switched) {
-    spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), switched.error().message);
+  std::string refusal;
+  auto route = plan_route(*vertex, 0, false, &refusal);
+  // Refused for good as things stand (another vehicle is due there, or a lock): stranded.
+  // Anything else (a topology or routing agent not up yet, a version conflict) passes.
+  if (!route && !stopping_ && (refusal == "no_window" || refusal == "locked")) {
+    return stranded_on(*vertex, route.error().message);
+  }
+  Status held = route ? switch_route(std::move(*route)) : Status(unexpected(route.error()));
+  if (!held) {
+    spdlog::warn("cannot hold '{}' yet: {}", topology_->id(*vertex), held.error().message);
+    pause_before_retry();
     return false;
   }
   position_alarm_raised_ = false;
+  hold_alarm_raised_ = false;
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
   release_passed(*status);  // what an earlier route left allocated and the vehicle does not need
   return true;
 }
 
 bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& why) {
-  keep_standing_reserved(vertex, kStrandedReserve);
+  keep_standing_reserved(vertex, kStrandedReserve + clock_.to_sim(2 * kRoutePause));
   if (!hold_alarm_raised_) {
     raise_alarm(msg::ALARM_WARNING,
                 fmt::format("vehicle '{}' cannot hold '{}' ({}): it keeps it reserved, so that the vehicles due "
@@ -181,13 +189,18 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
     clear_way_at_ = clock_.now() + kClearWayRetry;
     if (drive_to_nearest(topology::VertexKind::parking, false)) {
       spdlog::info("vehicle '{}' cleared the way: it holds '{}'", vehicle_id(), topology_->id(*vertex_));
+      hold_alarm_raised_ = false;
       return true;
     }
   }
   set_activity(Activity::waiting);
+  pause_before_retry();
+  return false;
+}
+
+void LogicalAgent::pause_before_retry() {
   std::unique_lock lock(mutex_);
   wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
-  return false;
 }
 
 void LogicalAgent::keep_standing_reserved(topology::EntityIndex vertex, DurationNs ahead) {
@@ -200,7 +213,9 @@ void LogicalAgent::keep_standing_reserved(topology::EntityIndex vertex, Duration
   const TimeNs end = route->step(granted->step).window.end;
   const TimeNs now = clock_.now();
   if (end == kForever || end - now > ahead / 2) return;
-  propagate_delay(*route, granted->step, now + ahead - end);
+  // At the vertex's owner only: what follows the step is cancelled (a route given up, or
+  // the rest of one being re-planned), so nothing else of the route is left to move.
+  delay_at_owner(*route, granted->step, now + ahead - end);
 }
 
 bool LogicalAgent::drivable(const std::vector<topology::RouteStep>& steps) const {
@@ -219,15 +234,18 @@ bool LogicalAgent::drivable(const std::vector<topology::RouteStep>& steps) const
   return true;
 }
 
-Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order) {
+Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order,
+                                              std::string* refusal) {
   const TimeNs give_up = clock_.now() + patience;
   bool warned = false;
+  if (refusal != nullptr) refusal->clear();
   for (;;) {
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     if (for_order && order_withdrawn()) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
     // Waiting here (a re-plan after a lock, say), the vehicle stands where its old route
-    // planned to leave: the route asked for starts on that vertex now.
-    keep_standing_reserved(*vertex_, 2 * options_.delay_threshold);
+    // planned to leave: the route asked for starts on that vertex now. Reserved for a
+    // retry's pause and call at least, whatever the clock's factor.
+    keep_standing_reserved(*vertex_, 2 * options_.delay_threshold + clock_.to_sim(2 * kRoutePause));
     topology::RouteId id = 0;
     while (id == 0) id = route_ids_();
     msg::RouteRequest request;
@@ -261,8 +279,7 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
       }
       cancel_route_quietly(id);
       set_activity(Activity::waiting);
-      std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
+      pause_before_retry();
       continue;
     }
     if (auto status = dds::from_wire(reply->error()); status) {
@@ -288,6 +305,7 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
       return RouteTracker(topology_, reply->route(), std::move(steps));
     } else {
       const std::string& failure = reply->failure();
+      if (refusal != nullptr) *refusal = failure;
       // A topology agent did not answer the routing agent: part of the route may be
       // reserved under this id (a commit whose reply was lost), so it is cancelled before
       // asking again under a new one.
@@ -309,8 +327,7 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
         if (auto requester = make_way_requested(); requester && make_way(*requester)) continue;
       }
       set_activity(Activity::waiting);
-      std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, kRoutePause, [&] { return stopping_.load(); });
+      pause_before_retry();
     }
   }
 }
@@ -321,7 +338,10 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   // route's first step (nobody can come between: the new reservation starts now and the
   // old one held the vertex since the vehicle arrived).
   if (monitor_.holds(here)) {
-    if (auto released = services_->release(vehicle_id(), here, monitor_.granted_as(here)); !released) return released;
+    if (auto released = services_->release(vehicle_id(), here, monitor_.granted_as(here)); !released) {
+      cancel_route_quietly(next.id());  // nothing was handed over: the new route must not stay reserved
+      return released;
+    }
     monitor_.drop(here);
   }
   for (;;) {
@@ -336,7 +356,6 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   }
   if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
   remnant_.reset();  // what it held of the vertex is handed over above; the rest is passed
-  hold_alarm_raised_ = false;
   if (next.size() > 1) {
     std::lock_guard lock(mutex_);
     make_way_.reset();  // the vehicle leaves anyway
@@ -373,6 +392,10 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
         return {};
       case FollowResult::replan:
         spdlog::info("re-planning from '{}'", topology_->id(*vertex_));
+        // The rest of the route goes now, but for what the vehicle holds: those due after it
+        // there need not wait for it, and while it waits for a new route only the vertex it
+        // stands on is kept reserved (keep_standing_reserved).
+        cancel_route_quietly(route_->id());
         continue;
       case FollowResult::failed:
         abandon_route();
@@ -538,13 +561,13 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
   return std::nullopt;
 }
 
-void LogicalAgent::propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by) {
+bool LogicalAgent::delay_at_owner(RouteTracker& route, std::size_t from_step, DurationNs by) {
   const auto entity = route.step(from_step).entity;
   auto shifts = services_->delay(vehicle_id(), route.id(), entity, by);
   if (!shifts) {
     spdlog::warn("delay of {} at '{}' not propagated: {}", seconds_text(by), topology_->id(entity),
                  shifts.error().message);
-    return;
+    return false;
   }
   for (const auto& shift : *shifts) {
     if (shift.agent == vehicle_id() && shift.route == route.id()) {
@@ -554,20 +577,23 @@ void LogicalAgent::propagate_delay(RouteTracker& route, std::size_t from_step, D
   }
   spdlog::info("delay of {} propagated from '{}' (step {}): {} route(s) moved", seconds_text(by),
                topology_->id(entity), from_step, shifts->size());
-  // The other owners of the route's reservations from that step on move their part too:
-  // those of the step's shadows (its conflicting entities across a border), then those of
-  // the later steps. Each moves everything of the route it holds from there.
+  return true;
+}
+
+void LogicalAgent::propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by) {
+  if (!delay_at_owner(route, from_step, by)) return;
+  // The owners of the rest of the route's partitions move their part too.
+  const auto entity = route.step(from_step).entity;
   std::set<std::string> partitions{topology_->partition(entity)};
-  const auto delay_where = [&](topology::EntityIndex other) {
-    if (!partitions.insert(topology_->partition(other)).second) return;
+  for (std::size_t step = from_step + 1; step < route.size(); ++step) {
+    const auto other = route.step(step).entity;
+    if (!partitions.insert(topology_->partition(other)).second) continue;
     auto more = services_->delay(vehicle_id(), route.id(), other, by);
-    if (!more) return;
+    if (!more) continue;
     for (const auto& shift : *more) {
       if (shift.agent == vehicle_id() && shift.route == route.id()) own_shift_echoes_.insert({shift.route, shift.by});
     }
-  };
-  for (const auto other : topology_->conflicts(entity)) delay_where(other);
-  for (std::size_t step = from_step + 1; step < route.size(); ++step) delay_where(route.step(step).entity);
+  }
 }
 
 void LogicalAgent::process_notices(bool& replan) {

@@ -121,7 +121,8 @@ class LogicalAgent {
   /// Where that vertex cannot be held (another vehicle is due there next, or it is locked):
   /// see stranded_on. \return whether it holds one now.
   bool hold_position();
-  /// The vehicle stands on `vertex` and cannot hold it (`why`): it keeps the vertex reserved
+  /// The vehicle stands on `vertex` and the routing agent refuses a hold of it (no_window,
+  /// locked: `why`): it keeps the vertex reserved
   /// ahead of now (keep_standing_reserved), so that the vehicles due there wait behind it
   /// and none is given the vertex under it, tells the operator once (a warning), and now
   /// and then tries to clear the way to a parking vertex. Pauses before returning, so that
@@ -131,9 +132,10 @@ class LogicalAgent {
   /// While the vehicle stands on `vertex` under a route step with a bounded window (it
   /// waits for a route there, or cannot hold it), that window must not run out: the next
   /// vehicle due there would be planned onto the vertex under it, and this vehicle could
-  /// plan no route from it. Once the window would end within `ahead` / 2, it is delayed
-  /// (I3: those due after it move back in order) to end `ahead` from now. Nothing for an
-  /// open-ended hold, or a vertex not held under a known route.
+  /// plan no route from it. Once the window would end within `ahead` / 2, it is delayed at
+  /// the vertex's owner (I3: those due after it move back in order) to end `ahead` from
+  /// now; the rest of that route is cancelled by then. Nothing for an open-ended hold, or a
+  /// vertex not held under a known route.
   void keep_standing_reserved(topology::EntityIndex vertex, DurationNs ahead);
   std::optional<topology::EntityIndex> vertex_under(const ran::VehicleStatus& status) const;
   /// A real route from the vehicle's vertex to `goal`, retried (within route_limit) while
@@ -142,7 +144,10 @@ class LogicalAgent {
   ///                  leave no route; 0: one try.
   /// \param for_order  the route serves the running order: waiting for one ends (an error)
   ///                  once the order is being withdrawn.
-  Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order);
+  /// \param refusal    when given and the routing agent refused the route, set to its
+  ///                  failure name (no_window, locked, conflict, ...); otherwise cleared.
+  Result<RouteTracker> plan_route(topology::EntityIndex goal, DurationNs patience, bool for_order,
+                                  std::string* refusal = nullptr);
   /// Whether `steps` alternate vertex, edge, vertex, ... with each edge drivable from the
   /// vertex before it to the vertex after it (what RouteTracker relies on).
   bool drivable(const std::vector<topology::RouteStep>& steps) const;
@@ -188,10 +193,15 @@ class LogicalAgent {
   void cancel_route_quietly(topology::RouteId route);
   void release_passed(const ran::VehicleStatus& status);
   void process_notices(bool& replan);
-  /// Delays `route` (route_ or remnant_) by `by` from its step `from_step` on, on every
-  /// topology agent that owns a reservation of it from there: the step's own, those that
-  /// hold its shadows (conflicting entities across a border) and those of the later steps.
+  /// Delays `route` (route_ or remnant_) by `by` from its step `from_step` on: at the owner
+  /// of that step's entity, then at the owners of the partitions of the later steps.
   void propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by);
+  /// The first part of propagate_delay: the delay at the owner of the step's entity (which
+  /// moves everything of the route it holds from there), followed in `route`.
+  /// \return whether that owner took it.
+  bool delay_at_owner(RouteTracker& route, std::size_t from_step, DurationNs by);
+  /// Waits kRoutePause (real time) before a retry, or until shutdown.
+  void pause_before_retry();
   /// Cancels the moves the RAN has not ended and waits (bounded) for a status after the
   /// cancel showing the vehicle still. \return whether it is known to stand with nothing
   /// commanded; false when the cancel did not reach the RAN (the moves stay pending, the
