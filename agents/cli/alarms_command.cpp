@@ -3,6 +3,9 @@
 // until Ctrl-C, SIGTERM or the end of --duration. Alarms are events: those raised before
 // it started are not shown.
 
+#include <signal.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iomanip>
@@ -12,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "agents/cli/dds_tool_options.hpp"
@@ -33,8 +37,29 @@ struct AlarmsArguments {
   bool json = false;
 };
 
+/// `text` on one line: line breaks and other control characters as \n, \r, \t or \xHH
+/// (an alarm's text may carry a RAN's reason: it must not forge a line of its own).
+std::string one_line(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (byte < 0x20 || byte == 0x7f) {
+      out += fmt::format("\\x{:02x}", byte);
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 /// One alarm as a line: "<shared-clock seconds> <SEVERITY> <vehicle or agent>: <text>", or
-/// a JSON object.
+/// a JSON object (bytes that are not UTF-8 replaced, so that the line stays valid JSON).
 std::string alarm_line(const msg::OperatorAlarm& alarm, bool json) {
   const std::string severity(logical_agent::severity_name(alarm.severity()));
   if (json) {
@@ -43,11 +68,11 @@ std::string alarm_line(const msg::OperatorAlarm& alarm, bool json) {
                           {"vehicle", alarm.vehicle()},
                           {"severity", severity},
                           {"text", alarm.text()}}
-        .dump();
+        .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   }
   std::ostringstream line;
   line << std::fixed << std::setprecision(3) << ns_to_seconds(alarm.time().ns()) << " " << severity << " "
-       << (alarm.vehicle().empty() ? alarm.agent() : alarm.vehicle()) << ": " << alarm.text();
+       << one_line(alarm.vehicle().empty() ? alarm.agent() : alarm.vehicle()) << ": " << one_line(alarm.text());
   return line.str();
 }
 
@@ -58,6 +83,9 @@ int run_alarms(const AlarmsArguments& arguments) {
               << "': expected info, warning, error or critical\n";
     return kExitBadInput;
   }
+  // A closed pipe (`droverctl alarms | head -1`) then fails the write, which ends the
+  // command, instead of killing it.
+  ::signal(SIGPIPE, SIG_IGN);
   if (auto installed = dds::install_shutdown_handlers(); !installed) {
     std::cerr << "error: " << installed.error().message << "\n";
     return kExitFailure;
@@ -76,9 +104,13 @@ int run_alarms(const AlarmsArguments& arguments) {
       [&](const msg::OperatorAlarm& alarm) {
         if (alarm.severity() < *minimum) return;
         std::lock_guard lock(output);
+        if (write_failed) return;
         // Flushed line by line: a follower piped into another tool sees each at once.
         std::cout << alarm_line(alarm, arguments.json) << std::endl;
-        write_failed = write_failed || !std::cout;
+        if (!std::cout) {  // a closed pipe, a full disk: nothing more can be shown
+          write_failed = true;
+          dds::request_shutdown();
+        }
       },
       events);
   if (!reader) {
@@ -87,16 +119,20 @@ int run_alarms(const AlarmsArguments& arguments) {
   }
   std::cerr << "following alarms on domain " << arguments.dds.domain_id << " (Ctrl-C to stop)\n";
   if (arguments.duration_seconds > 0) {
-    dds::wait_for_shutdown(std::chrono::milliseconds(static_cast<std::int64_t>(arguments.duration_seconds * 1000)));
+    const auto end = std::chrono::steady_clock::now() +
+                     std::chrono::milliseconds(static_cast<std::int64_t>(arguments.duration_seconds * 1000));
+    // In steps: one wait is bounded (about 24 days), the duration need not be.
+    while (!dds::shutdown_requested() && std::chrono::steady_clock::now() < end) {
+      dds::wait_for_shutdown(std::min<std::chrono::milliseconds>(
+          std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()),
+          std::chrono::hours(24)));
+    }
   } else {
     dds::wait_for_shutdown();
   }
   reader->reset();  // no callback after this
-  if (write_failed) {
-    std::cerr << "error: cannot write to standard output\n";
-    return kExitFailure;
-  }
-  return kExitOk;
+  // A failed write: run_app reports it ("cannot write to standard output") and exits 1.
+  return write_failed ? kExitFailure : kExitOk;
 }
 
 }  // namespace

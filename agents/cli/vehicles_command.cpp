@@ -103,7 +103,7 @@ void print_json(const std::map<std::string, msg::VehicleState>& states) {
                    {"state_of_charge", state.state_of_charge()},
                    {"time_ns", state.time().ns()}});
   }
-  std::cout << out.dump() << "\n";
+  std::cout << out.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
 }
 
 int run_vehicles(const VehiclesArguments& arguments) {
@@ -131,6 +131,18 @@ int run_vehicles(const VehiclesArguments& arguments) {
   }
   const auto states = collected.states();
   reader->reset();  // before `collected`, which its callback fills
+  std::vector<std::string> missing;
+  for (const auto& agent : *agents) {
+    if (agent.kind != "logical") continue;
+    for (const auto& vehicle : agent.owns) {
+      if (states.count(vehicle) == 0) missing.push_back(vehicle);
+    }
+  }
+  if (!missing.empty() && !states.empty()) {
+    std::cerr << "warning: no state from the logical agent of";
+    for (const auto& vehicle : missing) std::cerr << " '" << vehicle << "'";
+    std::cerr << " within " << arguments.dds.timeout_seconds << " s: not listed\n";
+  }
   if (states.empty()) {
     std::cerr << "error: no logical agent answered on domain " << arguments.dds.domain_id << " within "
               << arguments.dds.timeout_seconds << " s\n";

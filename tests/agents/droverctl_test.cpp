@@ -205,12 +205,14 @@ TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm)
   };
   ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_INFO, "route re-planned")).has_value());
   ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_CRITICAL, "left its allocated area")).has_value());
+  // A RAN's reason may carry a line break or bytes that are not UTF-8: still one valid line.
+  ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_ERROR, "caf\xe9\nforged")).has_value());
 
-  // The critical one shows (written after the info one, on a reliable topic: that one
-  // arrived first and was left out).
+  // The critical and error ones show (written after the info one, on a reliable topic: that
+  // one arrived first and was left out).
   std::string out;
   const auto deadline = std::chrono::steady_clock::now() + kDiscoveryTimeout;
-  while (out.find("left its allocated area") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+  while (out.find("forged") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     out = read_file(out_file);
   }
@@ -223,11 +225,13 @@ TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm)
   std::string line;
   std::vector<nlohmann::json> shown;
   while (std::getline(lines, line)) shown.push_back(nlohmann::json::parse(line));
-  ASSERT_EQ(shown.size(), 1u) << out;
+  ASSERT_EQ(shown.size(), 2u) << out;
   EXPECT_EQ(shown[0]["severity"], "critical");
   EXPECT_EQ(shown[0]["vehicle"], "V1");
   EXPECT_EQ(shown[0]["text"], "left its allocated area");
   EXPECT_EQ(shown[0]["time_ns"], seconds_to_ns(12.5));
+  EXPECT_EQ(shown[1]["severity"], "error");
+  EXPECT_EQ(shown[1]["text"], "caf\xef\xbf\xbd\nforged");  // U+FFFD for the stray byte
 }
 
 TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {

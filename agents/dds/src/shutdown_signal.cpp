@@ -5,7 +5,10 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdint>
+#include <limits>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -94,7 +97,10 @@ bool shutdown_requested() noexcept { return g_requested.load(); }
 void wait_for_shutdown() noexcept { wait_ms(-1); }
 
 bool wait_for_shutdown(std::chrono::milliseconds timeout) noexcept {
-  return wait_ms(static_cast<int>(timeout.count()));
+  // poll() takes an int of milliseconds: a longer wait is cut to that (about 24 days), a
+  // spurious "not requested" the caller's loop tells from a real timeout by the clock.
+  const auto capped = std::clamp<std::int64_t>(timeout.count(), 0, std::numeric_limits<int>::max());
+  return wait_ms(static_cast<int>(capped));
 }
 
 }  // namespace drover::dds

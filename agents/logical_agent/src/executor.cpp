@@ -384,7 +384,10 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
       if (route_ && !route_->arrived()) abandon_route();
       return unexpected(route.error());
     }
-    if (auto switched = switch_route(std::move(*route)); !switched) return switched;
+    if (auto switched = switch_route(std::move(*route)); !switched) {
+      if (route_ && !route_->arrived()) abandon_route();  // as above: hold_position takes over
+      return switched;
+    }
     std::string failure;
     switch (follow(failure)) {
       case FollowResult::arrived:

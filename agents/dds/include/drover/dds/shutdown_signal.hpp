@@ -29,7 +29,8 @@ bool shutdown_requested() noexcept;
 /// Blocks until shutdown is requested.
 void wait_for_shutdown() noexcept;
 
-/// Blocks until shutdown is requested or `timeout` passes. \return whether requested.
+/// Blocks until shutdown is requested or `timeout` passes (at most about 24 days per call).
+/// \return whether requested.
 bool wait_for_shutdown(std::chrono::milliseconds timeout) noexcept;
 
 }  // namespace drover::dds
