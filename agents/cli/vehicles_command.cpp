@@ -50,16 +50,18 @@ class VehicleStates {
   std::map<std::string, msg::VehicleState> states_;
 };
 
-/// Whether a state arrived from every live logical agent (their heartbeats name the
-/// vehicle they own), and from one at least.
-bool every_vehicle_seen(const std::vector<dds::AgentRecord>& agents,
-                        const std::map<std::string, msg::VehicleState>& states) {
-  if (states.empty()) return false;
-  return std::all_of(agents.begin(), agents.end(), [&](const dds::AgentRecord& agent) {
-    if (agent.kind != "logical" || !agent.alive) return true;
-    return std::all_of(agent.owns.begin(), agent.owns.end(),
-                       [&](const std::string& vehicle) { return states.count(vehicle) != 0; });
-  });
+/// The vehicles of live logical agents (their heartbeats name the vehicle they own) whose
+/// state has not arrived.
+std::vector<std::string> vehicles_unseen(const std::vector<dds::AgentRecord>& agents,
+                                         const std::map<std::string, msg::VehicleState>& states) {
+  std::vector<std::string> unseen;
+  for (const auto& agent : agents) {
+    if (agent.kind != "logical" || !agent.alive) continue;
+    for (const auto& vehicle : agent.owns) {
+      if (states.count(vehicle) == 0) unseen.push_back(vehicle);
+    }
+  }
+  return unseen;
 }
 
 std::string battery_text(double state_of_charge) {
@@ -123,7 +125,8 @@ int run_vehicles(const VehiclesArguments& arguments) {
   // Every logical agent present is discovered as `droverctl agents` does it, and has shown
   // its vehicle's state; never past the timeout.
   const auto agents = discover_live_agents(**participant, arguments.dds.timeout(), [&](const auto& records) {
-    return every_vehicle_seen(records, collected.states());
+    const auto states = collected.states();
+    return !states.empty() && vehicles_unseen(records, states).empty();
   });
   if (!agents) {
     std::cerr << "error: " << agents.error().message << "\n";
@@ -131,13 +134,7 @@ int run_vehicles(const VehiclesArguments& arguments) {
   }
   const auto states = collected.states();
   reader->reset();  // before `collected`, which its callback fills
-  std::vector<std::string> missing;
-  for (const auto& agent : *agents) {
-    if (agent.kind != "logical") continue;
-    for (const auto& vehicle : agent.owns) {
-      if (states.count(vehicle) == 0) missing.push_back(vehicle);
-    }
-  }
+  const auto missing = vehicles_unseen(*agents, states);
   if (!missing.empty() && !states.empty()) {
     std::cerr << "warning: no state from the logical agent of";
     for (const auto& vehicle : missing) std::cerr << " '" << vehicle << "'";
