@@ -168,7 +168,8 @@ Status TopologyAgent::start() {
                       serve(lock_server_, "lock", &TopologyAgent::on_lock),
                       serve(unlock_server_, "unlock", &TopologyAgent::on_unlock),
                       serve(delay_server_, "delay", &TopologyAgent::on_delay),
-                      serve(cancel_server_, "cancel_route", &TopologyAgent::on_cancel_route)}) {
+                      serve(cancel_server_, "cancel_route", &TopologyAgent::on_cancel_route),
+                      serve(holdings_server_, "holdings", &TopologyAgent::on_holdings)}) {
     if (!status) return status;
   }
 
@@ -198,6 +199,7 @@ TopologyAgent::~TopologyAgent() {
   unlock_server_.reset();
   delay_server_.reset();
   cancel_server_.reset();
+  holdings_server_.reset();
   std::lock_guard lock(mutex_);
   for (auto& [key, handle] : waiting_replies_) {
     send_error(handle, Error{ErrorCode::unavailable, "topology agent '" + agent_id() + "' shut down"});
@@ -515,6 +517,26 @@ void TopologyAgent::on_cancel_route(const msg::CancelRouteRequest& request, Stat
   send_status(reply, after_change(*grants, {std::move(event)}));
 }
 
+void TopologyAgent::on_holdings(const msg::HoldingsRequest& request, dds::ReplyHandle<msg::HoldingsReply> reply) {
+  if (request.agent().empty()) {
+    return send_error(reply, Error{ErrorCode::invalid_argument, "holdings: empty agent id"});
+  }
+  msg::HoldingsReply out;
+  {
+    std::lock_guard lock(mutex_);
+    const auto holdings = timelines_.holdings_of(request.agent());
+    for (const auto& [entity, step] : holdings.held) {
+      msg::HeldAllocation held;
+      held.entity(topology_.id(entity));
+      held.route(step.route);
+      held.step(step.step);
+      out.held().push_back(std::move(held));
+    }
+    out.routes(holdings.routes);
+  }
+  send_reply(reply, std::move(out));
+}
+
 void TopologyAgent::run_expiry() {
   std::unique_lock lock(mutex_);
   while (!expiry_wake_.wait_for(lock, options_.expiry_period, [this] { return stopping_; })) {
@@ -573,16 +595,20 @@ Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants,
   }
   for (auto& event : events) record(std::move(event));
   for (const auto& grant : grants) {
-    if (const auto step = timelines_.allocated_step(grant.entity)) {
-      if (auto held = find_real(timelines_.timeline(grant.entity), grant.agent, step->route, step->step)) {
-        record(make_event(msg::EVENT_ALLOCATED, *held));
-      }
-    }
+    const auto step = timelines_.allocated_step(grant.entity);
+    std::optional<topology::Reservation> held;
+    if (step) held = find_real(timelines_.timeline(grant.entity), grant.agent, step->route, step->step);
+    if (held) record(make_event(msg::EVENT_ALLOCATED, *held));
     if (!notify_grants) continue;
     msg::ReservationNotice notice;
     notice.agent(grant.agent);
     notice.kind(msg::NOTICE_ALLOCATION_GRANTED);
     notice.entity(topology_.id(grant.entity));
+    if (held) {
+      notice.route(held->route);
+      notice.from_step(held->step);
+      notice.window(to_wire(held->window));
+    }
     notify(std::move(notice));
   }
   // Queued requests: answered once their agent holds the entity, or with an error once it

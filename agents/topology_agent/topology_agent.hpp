@@ -106,6 +106,7 @@ class TopologyAgent {
   void on_unlock(const msg::UnlockRequest& request, StatusHandle reply);
   void on_delay(const msg::DelayRequest& request, dds::ReplyHandle<msg::DelayReply> reply);
   void on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply);
+  void on_holdings(const msg::HoldingsRequest& request, dds::ReplyHandle<msg::HoldingsReply> reply);
   void run_expiry();
 
   // The members below run with mutex_ held.
@@ -180,6 +181,7 @@ class TopologyAgent {
   Server<msg::UnlockRequest, msg::StatusReply> unlock_server_;
   Server<msg::DelayRequest, msg::DelayReply> delay_server_;
   Server<msg::CancelRouteRequest, msg::StatusReply> cancel_server_;
+  Server<msg::HoldingsRequest, msg::HoldingsReply> holdings_server_;
 };
 
 }  // namespace drover::topology_agent

@@ -97,6 +97,7 @@ class TopologyAgentTest : public ::testing::Test {
     unlock_.reset();
     delay_.reset();
     cancel_.reset();
+    holdings_.reset();
     participant_.reset();
     agents_.clear();
     std::filesystem::remove(topology_file_);
@@ -123,6 +124,7 @@ class TopologyAgentTest : public ::testing::Test {
     unlock_ = make_client<msg::UnlockRequest, msg::StatusReply>(*participant_, "unlock");
     delay_ = make_client<msg::DelayRequest, msg::DelayReply>(*participant_, "delay");
     cancel_ = make_client<msg::CancelRouteRequest, msg::StatusReply>(*participant_, "cancel_route");
+    holdings_ = make_client<msg::HoldingsRequest, msg::HoldingsReply>(*participant_, "holdings");
     auto timelines = dds::Reader<msg::TimelineState>::create(
         *participant_, topology_agent::kTimelineTopic, [this](const msg::TimelineState& state) {
           std::lock_guard lock(mutex_);
@@ -311,6 +313,7 @@ class TopologyAgentTest : public ::testing::Test {
   Client<msg::UnlockRequest, msg::StatusReply> unlock_;
   Client<msg::DelayRequest, msg::DelayReply> delay_;
   Client<msg::CancelRouteRequest, msg::StatusReply> cancel_;
+  Client<msg::HoldingsRequest, msg::HoldingsReply> holdings_;
   std::vector<std::shared_ptr<void>> readers_;
 
   std::mutex mutex_;
@@ -358,7 +361,7 @@ TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingP
   EXPECT_EQ(timeline("a").reservations().size(), 1u);
 }
 
-TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequesterIsAnsweredOnRelease) {
+TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderHoldingsShowItAndAQueuedRequesterIsAnsweredOnRelease) {
   start_agent(71);
   connect(71);
   reserve("v1", 1, {{"b", {1000, 2000}}});
@@ -372,6 +375,26 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequest
   const auto first = allocate("v1", "b", false);
   EXPECT_EQ(first.error().code(), msg::ERROR_NONE) << first.error().message();
   EXPECT_TRUE(first.granted());
+  // What each agent has here (what a restarted logical agent asks for).
+  msg::HoldingsRequest of_v1;
+  of_v1.agent("v1");
+  const auto v1 = holdings_->call(of_v1, kDiscoveryTimeout);
+  ASSERT_TRUE(v1.has_value()) << v1.error().message;
+  EXPECT_EQ(v1->error().code(), msg::ERROR_NONE) << v1->error().message();
+  ASSERT_EQ(v1->held().size(), 1u);
+  EXPECT_EQ(v1->held()[0].entity(), "b");
+  EXPECT_EQ(v1->held()[0].route(), 1u);
+  EXPECT_EQ(v1->held()[0].step(), 0u);
+  EXPECT_EQ(v1->routes(), std::vector<std::uint64_t>{1});
+  msg::HoldingsRequest of_v2;
+  of_v2.agent("v2");
+  const auto v2 = holdings_->call(of_v2, kDiscoveryTimeout);
+  ASSERT_TRUE(v2.has_value()) << v2.error().message;
+  EXPECT_TRUE(v2->held().empty());
+  EXPECT_EQ(v2->routes(), std::vector<std::uint64_t>{1});
+  const auto nobody = holdings_->call(msg::HoldingsRequest{}, kDiscoveryTimeout);
+  ASSERT_TRUE(nobody.has_value()) << nobody.error().message;
+  EXPECT_EQ(nobody->error().code(), msg::ERROR_INVALID_ARGUMENT);
 
   auto waiting = std::async(std::launch::async, [this] { return allocate("v2", "b", true); });
   EXPECT_TRUE(wait_until([&] {
@@ -387,7 +410,11 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderAndAQueuedRequest
   EXPECT_TRUE(wait_until([&] { return timelines_["b"].holder() == "v2" && timelines_["b"].waiting().empty(); }));
   EXPECT_TRUE(wait_until([&] {
     for (const auto& notice : notices_) {
-      if (notice.agent() == "v2" && notice.kind() == msg::NOTICE_ALLOCATION_GRANTED && notice.entity() == "b") return true;
+      // The notice names the step granted (route 1, step 0, its window).
+      if (notice.agent() == "v2" && notice.kind() == msg::NOTICE_ALLOCATION_GRANTED && notice.entity() == "b" &&
+          notice.route() == 1 && notice.from_step() == 0 && notice.window().start() == 3000) {
+        return true;
+      }
     }
     return false;
   }));

@@ -17,6 +17,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -498,7 +499,13 @@ TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
 TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   constexpr std::uint32_t kDomain = 87;
   Fleet fleet(kDomain, "stall");
-  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1", "V2"});
+  fleet.start_vehicle("V1", "left-0");
+  // V2 tells the operator once it has waited 4 s for one allocation.
+  fleet.start_vehicle("V2", "right-0", {}, {"--park-after", "-1", "--charge-below", "0", "--wait-alarm", "4"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
   ASSERT_EQ(send_order("V1", "v1-stall", {{"right-4", "NOP"}}), "");
   // V2's order only once V1 drives (its route is reserved): V1 is then first on the bar.
   ASSERT_TRUE(seen_.wait(
@@ -554,6 +561,17 @@ TEST_F(FleetTest, StalledVehiclePropagatesADelayTheOtherFollowsAndBothFinish) {
   ASSERT_EQ(v1.size(), 1u);
   ASSERT_EQ(v2.size(), 1u);
   EXPECT_GE(v2.front().first, v1.front().second) << "V2 overtook the stalled V1 on bar-2";
+  // Held up for the 10 s of the stall, V2 warned the operator, once per entity it waited
+  // for; V1 had nothing to say.
+  std::set<std::string> waited_for;
+  for (const auto& alarm : seen_.alarms) {
+    if (alarm.vehicle() != "V2" || alarm.text().find("has waited") == std::string::npos) continue;
+    EXPECT_EQ(alarm.severity(), msg::ALARM_WARNING) << alarm.text();
+    EXPECT_TRUE(waited_for.insert(alarm.text().substr(alarm.text().find(" for "))).second)
+        << "warned twice: " << alarm.text();
+  }
+  EXPECT_FALSE(waited_for.empty()) << "V2 did not warn of its wait";
+  for (const auto& alarm : seen_.alarms) EXPECT_NE(alarm.vehicle(), "V1") << alarm.text();
 }
 
 TEST_F(FleetTest, LockOnThePlannedRouteMakesTheVehicleReplanAroundIt) {
@@ -627,6 +645,39 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
 
   // A new route is reserved and allocated at the restarted topology agent.
   ASSERT_NO_FATAL_FAILURE(expect_crossing_orders_and_one_more_finish());
+}
+
+TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTheRouteItLeft) {
+  constexpr std::uint32_t kDomain = 45;
+  Fleet fleet(kDomain, "logical-restart");
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
+  // V1 drives towards right-4, its route reserved over the bar to the station (held there
+  // open-ended); its logical agent crashes on the way and is started again.
+  ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  fleet.crash_and_restart("V1");
+
+  // The new life takes over the vehicle where it stands and gives up the route the old one
+  // left reserved: V2 gets the station, and V1 drives again.
+  ASSERT_EQ(send_order("V2", "v2-station", {{"right-4", "NOP"}}), "");
+  const auto station = wait_order("v2-station");
+  ASSERT_TRUE(station.has_value()) << "V2's order did not end";
+  EXPECT_EQ(station->state(), msg::ORDER_FINISHED) << station->failure();
+  // What the earlier life held behind the vehicle is released (it stopped on left-2, where
+  // its last move took it).
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders["left-0"].empty() && seen_.holders["left-0<->left-1"].empty(); },
+                         30s))
+      << "V1 still holds what it left behind";
+  ASSERT_EQ(send_order("V1", "v1-home", {{"left-0", "NOP"}}), "");
+  const auto home = wait_order("v1-home");
+  ASSERT_TRUE(home.has_value()) << "V1's order did not end";
+  EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_EQ(seen_.holders["left-0"], "V1");
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
 }
 
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {

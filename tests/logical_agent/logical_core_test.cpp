@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "agents/logical_agent/src/footprint_monitor.hpp"
+#include "agents/logical_agent/src/late_grants.hpp"
 #include "agents/logical_agent/src/order_book.hpp"
 #include "agents/logical_agent/src/route_tracker.hpp"
 #include "agents/logical_agent/src/travel_time.hpp"
@@ -171,6 +172,26 @@ TEST(OrderBook, OperationsBecomeRanActions) {
 }
 
 // ---- route tracking ----
+
+TEST(LateGrants, GivesBackWhatNobodyClaimsAndKeepsTheCurrentRoutesGrantsForTheirClaim) {
+  using namespace std::chrono_literals;
+  LateGrants grants(2s);
+  const auto t0 = LateGrants::Clock::time_point{} + 100s;
+  grants.granted(4, HeldStep{7, 2}, t0);  // of the current route 7: its claim may come
+  grants.granted(5, HeldStep{6, 1}, t0);  // of route 6, given up since
+  grants.granted(9, HeldStep{7, 4}, t0);  // claimed by an allocate reply in the meantime
+  const auto held = [](topology::EntityIndex entity) { return entity == 9; };
+  using Released = std::vector<std::pair<topology::EntityIndex, HeldStep>>;
+  EXPECT_EQ(grants.to_release(held, 7, t0 + 1s), (Released{{5, HeldStep{6, 1}}}));
+  EXPECT_EQ(grants.to_release(held, 7, t0 + 1s), Released{});  // each is returned once
+  EXPECT_FALSE(grants.empty());
+  // Unclaimed for longer than the claim may take: given back too.
+  EXPECT_EQ(grants.to_release(held, 7, t0 + 3s), (Released{{4, HeldStep{7, 2}}}));
+  EXPECT_TRUE(grants.empty());
+  // Without a current route nothing waits for a claim.
+  grants.granted(4, HeldStep{7, 2}, t0);
+  EXPECT_EQ(grants.to_release(held, std::nullopt, t0), (Released{{4, HeldStep{7, 2}}}));
+}
 
 TEST(RouteTracker, AllocatesWithinTheLookAheadAndMovesOnlyOntoAllocatedSteps) {
   const auto world = h_crossing();

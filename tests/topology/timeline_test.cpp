@@ -689,6 +689,23 @@ TEST_F(TimelineTest, CancelKeepsTheAllocatedStepAndGrantsWhoWaited) {
   EXPECT_EQ(set.cancel_route("amy", 42).error().code, ErrorCode::not_found);
 }
 
+TEST_F(TimelineTest, HoldingsOfAnAgentNameWhatItHoldsAndEveryRouteItHasItemsOf) {
+  EXPECT_EQ(set.holdings_of("amy"), AgentHoldings{});
+  ASSERT_TRUE(set.reserve("amy", 7, {at(0, 0, 10), at(2, 9, 20)}));
+  ASSERT_TRUE(set.reserve("amy", 3, {at(2, 30, 40)}));
+  ASSERT_TRUE(set.prepare(set.expand("amy", 9, {at(3, 50, 60)}), {}, 100));  // prepared only
+  ASSERT_TRUE(set.reserve("bob", 1, {at(3, 0, 10)}));
+  ASSERT_TRUE(set.allocate("amy", 0)->granted);
+  ASSERT_TRUE(set.allocate("bob", 3)->granted);
+  const TimelineSet before = set;
+  const AgentHoldings amy = set.holdings_of("amy");
+  EXPECT_EQ(amy.held, (std::vector<std::pair<EntityIndex, AllocatedStep>>{{0, AllocatedStep{7, 0}}}));
+  EXPECT_EQ(amy.routes, (std::vector<RouteId>{3, 7, 9}));
+  EXPECT_EQ(set.holdings_of("bob").held, (std::vector<std::pair<EntityIndex, AllocatedStep>>{{3, AllocatedStep{1, 0}}}));
+  EXPECT_EQ(set.holdings_of("cat"), AgentHoldings{});
+  EXPECT_TRUE(set == before);  // a query
+}
+
 TEST_F(TimelineTest, CancelWithdrawsWaitingRequestsAndPreparedSets) {
   ASSERT_TRUE(set.reserve("amy", 1, {at(2, 0, 10)}));
   ASSERT_TRUE(set.reserve("bob", 1, {at(2, 20, 30)}));

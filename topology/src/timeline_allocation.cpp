@@ -89,6 +89,21 @@ std::optional<AllocatedStep> TimelineSet::allocated_step(EntityIndex entity) con
   return owns(entity) ? held_[entity] : std::nullopt;
 }
 
+AgentHoldings TimelineSet::holdings_of(const AgentId& agent) const {
+  AgentHoldings out;
+  for (EntityIndex entity = 0; entity < timelines_.size(); ++entity) {
+    if (!owns(entity)) continue;
+    const Timeline& t = timelines_[entity];
+    if (t.holder == agent && held_[entity]) out.held.emplace_back(entity, *held_[entity]);
+    for (const Reservation& r : t.reservations) {
+      if (r.agent == agent) out.routes.push_back(r.route);
+    }
+  }
+  std::sort(out.routes.begin(), out.routes.end());
+  out.routes.erase(std::unique(out.routes.begin(), out.routes.end()), out.routes.end());
+  return out;
+}
+
 Result<std::vector<Grant>> TimelineSet::release(const AgentId& agent, EntityIndex entity) {
   if (agent.empty()) return fail(ErrorCode::invalid_argument, "release: empty agent id");
   if (!owns(entity)) {

@@ -116,6 +116,7 @@ const std::vector<KindRules>& kind_rules() {
         {"charge_to", "--charge-to", FieldType::positive_number, 0, 1},
         {"error_limit", "--error-limit", FieldType::positive_number},
         {"route_limit", "--route-limit", FieldType::number},
+        {"wait_alarm", "--wait-alarm", FieldType::number},
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
        {{"seed", "--seed", FieldType::count, 0, kLargestWhole},

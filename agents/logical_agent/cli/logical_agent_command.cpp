@@ -35,6 +35,7 @@ struct LogicalAgentArguments {
   double charge_to = logical_agent::kDefaultChargeTo;
   double error_limit = 60;
   double route_limit = 120;
+  double wait_alarm = 60;
 };
 
 int fail_input(const std::string& message) {
@@ -69,6 +70,7 @@ int run(const LogicalAgentArguments& arguments) {
   options.charge_to = arguments.charge_to;
   options.error_limit = seconds_to_ns(arguments.error_limit);
   options.route_limit = seconds_to_ns(arguments.route_limit);
+  options.wait_alarm = seconds_to_ns(arguments.wait_alarm);
 
   auto clock = make_clock(arguments.clock);
   if (!clock) return fail_input(clock.error().message);
@@ -129,6 +131,9 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
       ->transform(cli::positive());
   command->add_option("--route-limit", arguments->route_limit,
                       "s to keep asking for a route the timelines or locks refuse (default 120)")
+      ->transform(cli::non_negative());
+  command->add_option("--wait-alarm", arguments->wait_alarm,
+                      "s waiting for one allocation before the operator is warned; 0: never (default 60)")
       ->transform(cli::non_negative());
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });

@@ -55,6 +55,7 @@ std::optional<ran::VehicleStatus> LogicalAgent::latest_status() {
 }
 
 void LogicalAgent::run() {
+  if (!take_over()) return;
   idle_since_ = clock_.now();
   while (!stopping_) {
     bool replan = false;
@@ -142,6 +143,10 @@ bool LogicalAgent::hold_position() {
     std::lock_guard lock(mutex_);
     if (!status_ || std::chrono::steady_clock::now() - status_received_ > kRanSilence) return false;
     status = status_;
+  }
+  if (earlier_commands_running(*status)) {
+    set_activity(Activity::waiting);
+    return false;
   }
   const auto vertex = vertex_under(*status);
   if (!vertex) {
@@ -360,6 +365,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     std::lock_guard lock(mutex_);
     make_way_.reset();  // the vehicle leaves anyway
   }
+  end_allocation_wait();
   monitor_.forget_steps();
   monitor_.hold(here, HeldStep{next.id(), 0});
   next.mark_allocated();
@@ -490,7 +496,11 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
           replan = true;
           break;
         }
-        if (!outcome->granted) break;
+        if (!outcome->granted) {
+          note_allocation_wait(entity);
+          break;
+        }
+        end_allocation_wait();
         monitor_.hold(entity, HeldStep{route_->id(), static_cast<std::uint32_t>(*next)});
         route_->mark_allocated();
       }
@@ -515,6 +525,25 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
     publish_vehicle_state(false);
     wait_event();
   }
+}
+
+void LogicalAgent::note_allocation_wait(topology::EntityIndex entity) {
+  const TimeNs now = clock_.now();
+  if (!allocation_wait_ || allocation_wait_->entity != entity) allocation_wait_ = AllocationWait{entity, now, false};
+  if (allocation_wait_->told || options_.wait_alarm <= 0 || now - allocation_wait_->since < options_.wait_alarm) return;
+  const auto& id = topology_->id(entity);
+  raise_alarm(msg::ALARM_WARNING, fmt::format("vehicle '{}' has waited {} for '{}': the vehicle due there before it "
+                                              "does not move on ('droverctl timeline {}' shows who)",
+                                              vehicle_id(), seconds_text(now - allocation_wait_->since), id, id));
+  allocation_wait_->told = true;
+}
+
+void LogicalAgent::end_allocation_wait() {
+  if (allocation_wait_ && allocation_wait_->told) {
+    spdlog::info("the wait for '{}' is over after {}", topology_->id(allocation_wait_->entity),
+                 seconds_text(clock_.now() - allocation_wait_->since));
+  }
+  allocation_wait_.reset();
 }
 
 void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
@@ -606,6 +635,14 @@ void LogicalAgent::process_notices(bool& replan) {
     batch.swap(notices_);
   }
   for (const auto& notice : batch) {
+    if (notice.kind() == msg::NOTICE_ALLOCATION_GRANTED) {
+      // Claimed by the allocate reply, usually: only the grants it missed matter.
+      const auto entity = topology_->find(notice.entity());
+      if (entity && !monitor_.holds(*entity)) {
+        late_grants_.granted(*entity, HeldStep{notice.route(), notice.from_step()}, std::chrono::steady_clock::now());
+      }
+      continue;
+    }
     if (!route_ || notice.route() != route_->id()) continue;
     if (notice.kind() == msg::NOTICE_SHIFTED) {
       const auto echo = own_shift_echoes_.find({notice.route(), notice.shift()});
@@ -643,6 +680,23 @@ void LogicalAgent::process_notices(bool& replan) {
           break;
         }
       }
+    }
+  }
+  give_back_late_grants();
+}
+
+void LogicalAgent::give_back_late_grants() {
+  if (late_grants_.empty()) return;
+  const auto claimed = [this](topology::EntityIndex entity) { return monitor_.holds(entity); };
+  const auto current = route_ ? std::optional<topology::RouteId>(route_->id()) : std::nullopt;
+  for (const auto& [entity, step] : late_grants_.to_release(claimed, current, std::chrono::steady_clock::now())) {
+    // Not under the vehicle: moves go only onto what an allocate reply granted.
+    if (auto released = services_->release(vehicle_id(), entity, step); !released) {
+      spdlog::warn("'{}', granted after its request was given up, not released: {}", topology_->id(entity),
+                   released.error().message);
+    } else {
+      spdlog::info("'{}' was granted after its request was given up (route {} step {}): released", topology_->id(entity),
+                   step.route, step.step);
     }
   }
 }

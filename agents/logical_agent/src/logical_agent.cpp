@@ -276,7 +276,11 @@ void LogicalAgent::publish_progress(const Order& order) {
 }
 
 void LogicalAgent::raise_alarm(msg::AlarmSeverity severity, const std::string& text) {
-  spdlog::error("alarm: {}", text);
+  // The log says as much as the alarm: a warning is no error.
+  const auto level = severity == msg::ALARM_INFO      ? spdlog::level::info
+                     : severity == msg::ALARM_WARNING ? spdlog::level::warn
+                                                      : spdlog::level::err;
+  spdlog::log(level, "alarm: {}", text);
   msg::OperatorAlarm alarm;
   alarm.agent(vehicle_id());
   alarm.vehicle(vehicle_id());

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "agents/logical_agent/src/footprint_monitor.hpp"
+#include "agents/logical_agent/src/late_grants.hpp"
 #include "agents/logical_agent/src/order_book.hpp"
 #include "agents/logical_agent/src/route_tracker.hpp"
 #include "agents/logical_agent/src/topology_services.hpp"
@@ -66,6 +67,9 @@ struct LogicalAgentOptions {
   DurationNs error_limit = seconds_to_ns(60);
   /// How long no route may be found (locks, full timelines) before the order fails.
   DurationNs route_limit = seconds_to_ns(120);
+  /// Waiting this long (shared clock) for one allocation tells the operator (an
+  /// ALARM_WARNING, once per wait); 0: never.
+  DurationNs wait_alarm = seconds_to_ns(60);
   /// Real-time period of the executor's checks when nothing arrives.
   std::chrono::milliseconds tick{50};
   /// Real-time timeouts: topology calls, route calls, one allocation wait.
@@ -115,6 +119,20 @@ class LogicalAgent {
   /// Waits for an event or the tick. \return false when stopping.
   bool wait_event();
   std::optional<ran::VehicleStatus> latest_status();
+  // ---- taking over from an earlier life (take_over.cpp) ----
+  /// Once, before anything else: asks the topology agents what an earlier life of this
+  /// agent (one that crashed or was killed) left there. What it holds becomes this life's
+  /// (leftovers of an earlier route: hold_position swaps the vertex under the vehicle onto
+  /// its hold and releases the rest once the footprint leaves it); every route it left is
+  /// cancelled but for those allocations, so that nobody waits behind a route no one drives.
+  /// \return false only when stopping before the topology agents answered.
+  bool take_over();
+  /// Whether commands this life did not give (an earlier life's moves) still run on the
+  /// RAN, or the vehicle still moves after them: they end on what that life allocated,
+  /// which this life holds, so they are let run (a cancel would leave the vehicle part-way
+  /// along an edge) for error_limit at most, then cancelled.
+  bool earlier_commands_running(const ran::VehicleStatus& status);
+
   /// Finds the vertex the vehicle stands on and holds it with a route to itself (once a
   /// recent status shows it standing, after cancelling moves the RAN may still run), then
   /// releases what earlier routes left allocated that the vehicle does not need.
@@ -193,6 +211,13 @@ class LogicalAgent {
   void cancel_route_quietly(topology::RouteId route);
   void release_passed(const ran::VehicleStatus& status);
   void process_notices(bool& replan);
+  /// The allocation of `entity` was not granted (yet): raises the wait_alarm warning once
+  /// the vehicle has waited that long for it.
+  void note_allocation_wait(topology::EntityIndex entity);
+  /// An allocation was granted, or the route changed: the wait, if any, is over.
+  void end_allocation_wait();
+  /// Releases the allocations granted late that nobody claims (LateGrants).
+  void give_back_late_grants();
   /// Delays `route` (route_ or remnant_) by `by` from its step `from_step` on: at the owner
   /// of that step's entity, then at the owners of the partitions of the later steps.
   void propagate_delay(RouteTracker& route, std::size_t from_step, DurationNs by);
@@ -241,6 +266,8 @@ class LogicalAgent {
 
   // Executor state.
   FootprintMonitor monitor_;
+  /// Allocations notified as granted that no allocate reply claimed yet.
+  LateGrants late_grants_{std::chrono::seconds(2)};
   std::optional<RouteTracker> route_;
   /// The route abandon_route gave up last, until the next route begins: the vehicle may
   /// still hold steps of it (the vertex it stands on), whose windows keep_standing_reserved
@@ -263,6 +290,15 @@ class LogicalAgent {
   bool stop_undelivered_ = false;  ///< a cancel did not reach the RAN (warned once)
   bool position_alarm_raised_ = false;
   bool hold_alarm_raised_ = false;  ///< stranded_on told the operator (until a hold again)
+  /// The allocation the vehicle waits for (note_allocation_wait).
+  struct AllocationWait {
+    topology::EntityIndex entity = topology::kNoEntity;
+    TimeNs since = 0;
+    bool told = false;  ///< the operator was warned
+  };
+  std::optional<AllocationWait> allocation_wait_;
+  /// Since when commands of an earlier life are seen running (earlier_commands_running).
+  std::optional<TimeNs> earlier_commands_since_;
   TimeNs clear_way_at_ = 0;         ///< when stranded_on tries to clear the way next
   bool making_way_ = false;                          ///< driving aside: requests wait
   std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked

@@ -1,5 +1,6 @@
 #include "agents/logical_agent/src/topology_services.hpp"
 
+#include <algorithm>
 #include <set>
 #include <thread>
 
@@ -43,7 +44,8 @@ Result<std::unique_ptr<TopologyServices>> TopologyServices::create(dds::Particip
                       make_client(services->allocate_client_, participant, kTopologyArea, "allocate"),
                       make_client(services->release_client_, participant, kTopologyArea, "release"),
                       make_client(services->delay_client_, participant, kTopologyArea, "delay"),
-                      make_client(services->cancel_client_, participant, kTopologyArea, "cancel_route")}) {
+                      make_client(services->cancel_client_, participant, kTopologyArea, "cancel_route"),
+                      make_client(services->holdings_client_, participant, kTopologyArea, "holdings")}) {
     if (!status) return unexpected(status.error());
   }
   return services;
@@ -184,6 +186,36 @@ Status TopologyServices::cancel_route(const std::string& agent, topology::RouteI
     if (!done) return unexpected(done.error());
   }
   return {};
+}
+
+Result<Holdings> TopologyServices::holdings(const std::string& agent) {
+  Holdings out;
+  for (const auto& partition : topology_->partitions()) {
+    auto reply = retry<msg::HoldingsReply>([&]() -> Result<msg::HoldingsReply> {
+      auto owner = owner_of_partition(partition);
+      if (!owner) return unexpected(owner.error());
+      msg::HoldingsRequest request;
+      request.agent(agent);
+      auto answer = holdings_client_->call(request, call_timeout_, *owner);
+      if (!answer) return unexpected(answer.error());
+      if (auto status = dds::from_wire(answer->error()); !status) return unexpected(status.error());
+      return answer;
+    });
+    if (!reply) return unexpected(reply.error());
+    for (const auto& held : reply->held()) {
+      const auto entity = topology_->find(held.entity());
+      if (!entity) {
+        spdlog::warn("'{}' holds '{}' in partition '{}', which topology '{}' does not have", agent, held.entity(),
+                     partition, topology_->name());
+        continue;
+      }
+      out.held.emplace_back(*entity, HeldStep{held.route(), held.step()});
+    }
+    out.routes.insert(out.routes.end(), reply->routes().begin(), reply->routes().end());
+  }
+  std::sort(out.routes.begin(), out.routes.end());
+  out.routes.erase(std::unique(out.routes.begin(), out.routes.end()), out.routes.end());
+  return out;
 }
 
 }  // namespace drover::logical_agent

@@ -28,6 +28,12 @@ struct AllocateOutcome {
   std::size_t queue_position = 0;
 };
 
+/// What an agent has at the topology agents (TopologyServices::holdings).
+struct Holdings {
+  std::vector<std::pair<topology::EntityIndex, HeldStep>> held;  ///< the entities it holds
+  std::vector<topology::RouteId> routes;  ///< routes it has reservations of, ascending, each once
+};
+
 /// Thread-safe. Must be destroyed before its Participant.
 class TopologyServices {
  public:
@@ -62,6 +68,11 @@ class TopologyServices {
   /// \return success, or the first other error.
   Status cancel_route(const std::string& agent, topology::RouteId route, const std::vector<std::uint32_t>& held_steps);
 
+  /// What `agent` has at the owners of every partition, each asked until it answers.
+  /// Entities the topology does not know are left out (with a warning).
+  /// \return them, or the first other error (unavailable once stopping).
+  Result<Holdings> holdings(const std::string& agent);
+
   /// The live topology agent owning `entity`. \return its id, or unavailable.
   Result<std::string> owner_of(topology::EntityIndex entity) const;
   /// The live topology agent owning `partition`. \return its id, or unavailable.
@@ -89,6 +100,7 @@ class TopologyServices {
   Client<msg::ReleaseRequest, msg::StatusReply> release_client_;
   Client<msg::DelayRequest, msg::DelayReply> delay_client_;
   Client<msg::CancelRouteRequest, msg::StatusReply> cancel_client_;
+  Client<msg::HoldingsRequest, msg::HoldingsReply> holdings_client_;
 };
 
 }  // namespace drover::logical_agent

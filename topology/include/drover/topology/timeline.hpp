@@ -113,6 +113,13 @@ struct AllocatedStep {
   friend bool operator==(const AllocatedStep&, const AllocatedStep&) = default;
 };
 
+/// What one agent has in a set (TimelineSet::holdings_of).
+struct AgentHoldings {
+  std::vector<std::pair<EntityIndex, AllocatedStep>> held;  ///< owned entities it holds, ascending
+  std::vector<RouteId> routes;                               ///< routes it has items of, ascending
+  friend bool operator==(const AgentHoldings&, const AgentHoldings&) = default;
+};
+
 /// Outcome of an allocation request.
 struct Allocation {
   bool granted = false;
@@ -359,6 +366,11 @@ class TimelineSet {
   /// The route step the holder of `entity` holds; nullopt when nobody holds it (or the
   /// entity is not owned). Timeline::holder names the agent.
   std::optional<AllocatedStep> allocated_step(EntityIndex entity) const;
+
+  /// What `agent` has here: the owned entities it holds with the step each allocation
+  /// holds, and every route it has reservations of on owned entities (real or shadow,
+  /// committed or prepared). Empty for an agent without any.
+  AgentHoldings holdings_of(const AgentId& agent) const;
 
   /// Gives up the allocation of `entity`: removes the agent's allocated reservation there
   /// and its shadows. not_permitted if the agent does not hold it.

@@ -43,6 +43,8 @@ DROVER_DDS_MESSAGE(UnlockRequest);
 DROVER_DDS_MESSAGE(DelayRequest);
 DROVER_DDS_MESSAGE(DelayReply);
 DROVER_DDS_MESSAGE(CancelRouteRequest);
+DROVER_DDS_MESSAGE(HoldingsRequest);
+DROVER_DDS_MESSAGE(HoldingsReply);
 DROVER_DDS_MESSAGE(ReservationNotice);
 DROVER_DDS_MESSAGE(RouteRequest);
 DROVER_DDS_MESSAGE(RouteReply);
