@@ -173,6 +173,8 @@ Status TopologyAgent::start() {
     if (!status) return status;
   }
 
+  if (auto watched = watch_departures(); !watched) return watched;
+
   dds::HeartbeatOptions beat;
   beat.kind = "topology";
   beat.owns = served_partitions();
@@ -183,6 +185,14 @@ Status TopologyAgent::start() {
 }
 
 TopologyAgent::~TopologyAgent() {
+  // Departures first: a sweep publishes through the writers and serves no request.
+  directory_.reset();
+  {
+    std::lock_guard lock(departed_mutex_);
+    departed_stop_ = true;
+  }
+  departed_wake_.notify_all();
+  if (departed_thread_.joinable()) departed_thread_.join();
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;

@@ -19,6 +19,9 @@
 #include <vector>
 
 #include "agents/topology_agent/journal.hpp"
+#include "drover/dds/agent_directory.hpp"
+#include "drover/dds/service_client.hpp"
+#include "drover/logical_agent/messages.hpp"
 #include "drover/common/clock.hpp"
 #include "drover/common/result.hpp"
 #include "drover/dds/heartbeat_publisher.hpp"
@@ -53,6 +56,11 @@ struct TopologyAgentOptions {
   std::filesystem::path journal_file;
   /// How often prepared holds past their expiry are dropped.
   std::chrono::milliseconds expiry_period{100};
+  /// A logical agent without a heartbeat this long (real time) loses its reservations in
+  /// this partition but for what its vehicle occupies, and the operators are told what it
+  /// keeps (DESIGN.md "Failure handling"; docs/topology-agent.md "Departed logical
+  /// agents"). 0: never.
+  std::chrono::milliseconds departed_after{10000};
   /// TEST HOOK: commits are applied but never answered (a reply lost on the way), so that
   /// tests can check what a routing agent does with a commit of unknown outcome.
   bool drop_commit_replies = false;
@@ -108,6 +116,24 @@ class TopologyAgent {
   void on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply);
   void on_holdings(const msg::HoldingsRequest& request, dds::ReplyHandle<msg::HoldingsReply> reply);
   void run_expiry();
+
+  // ---- logical agents that went away (departed_agents.cpp) ----
+  /// Starts watching the logical agents' heartbeats (with departed_after > 0).
+  Status watch_departures();
+  /// From the directory's thread: a logical agent died (its sweep is due departed_after
+  /// later) or came back (nothing is due).
+  void on_agent_change(const dds::AgentRecord& record);
+  /// The departures thread: sweeps each departed agent once its time is due, unless it came
+  /// back meanwhile.
+  void run_departures();
+  /// Cancels every route `agent` has in this partition but for the steps it holds in any
+  /// partition (its vehicle may stand on them or drive into them), and raises an operator
+  /// alarm naming what it keeps allocated here. Takes mutex_ itself.
+  void sweep_departed(const std::string& agent, const std::string& why);
+  /// The steps `agent` holds in the other partitions, by route, asked of their owners (no
+  /// lock held: they may be asking this agent at the same time). nullopt when an owner did
+  /// not answer.
+  std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> held_abroad(const std::string& agent);
 
   // The members below run with mutex_ held.
   /// Saves every owned timeline whose version differs from the one last published to the
@@ -170,6 +196,20 @@ class TopologyAgent {
   std::condition_variable expiry_wake_;
   bool stopping_ = false;
   std::thread expiry_thread_;
+
+  // Departed logical agents, under departed_mutex_ (never taken with mutex_ held).
+  std::unique_ptr<dds::AgentDirectory> directory_;
+  std::unique_ptr<dds::ServiceClient<msg::HoldingsRequest, msg::HoldingsReply>> holdings_client_;
+  std::unique_ptr<dds::Writer<msg::OperatorAlarm>> alarm_writer_;
+  std::mutex departed_mutex_;
+  std::condition_variable departed_wake_;
+  bool departed_stop_ = false;
+  struct Departure {
+    std::chrono::steady_clock::time_point due;
+    std::string why;
+  };
+  std::map<std::string, Departure> departed_;  ///< logical agent id -> its sweep
+  std::thread departed_thread_;
 
   // Servers last: destroyed first, so no handler runs while the rest goes away.
   Server<msg::ReservePrepareRequest, msg::ReservePrepareReply> prepare_server_;

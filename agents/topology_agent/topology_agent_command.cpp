@@ -28,6 +28,7 @@ struct TopologyAgentArguments {
   ClockArguments clock;
   std::string log_level = "info";
   bool drop_commit_replies = false;
+  double departed_after = 10;
 };
 
 int run(const TopologyAgentArguments& arguments) {
@@ -52,6 +53,7 @@ int run(const TopologyAgentArguments& arguments) {
   options.partition = arguments.partition;
   options.journal_file = arguments.journal_file;
   options.drop_commit_replies = arguments.drop_commit_replies;
+  options.departed_after = std::chrono::milliseconds(static_cast<std::int64_t>(arguments.departed_after * 1000));
   options.participant.domain_id = arguments.domain_id;
   options.participant.agent_id = agent_id;
   options.participant.xml_profile_file = arguments.xml_profile;
@@ -90,6 +92,10 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
                       "Agent id (default: topology-<partition>, or topology)");
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
+  command->add_option("--departed-after", arguments->departed_after,
+                      "s without a heartbeat before a logical agent's reservations here go, but for what "
+                      "its vehicle occupies; 0: never (default 10)")
+      ->transform(cli::non_negative());
   add_clock_options(*command, arguments->clock);
   command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));

@@ -112,13 +112,18 @@ class Fleet {
   }
   /// SIGKILL to the agent started as `name` (a crash), then the same agent again.
   void crash_and_restart(const std::string& name) {
+    std::vector<std::string> args;
+    ASSERT_NO_FATAL_FAILURE(crash(name, &args));
+    start(name, args);
+  }
+  /// SIGKILL to the agent started as `name` (a crash); its arguments go to `args` if given.
+  void crash(const std::string& name, std::vector<std::string>* args = nullptr) {
     auto found = std::find_if(children_.begin(), children_.end(), [&](const Child& c) { return c.name == name; });
     ASSERT_NE(found, children_.end()) << name;
     found->process.signal(SIGKILL);
     ASSERT_TRUE(found->process.wait_exit(30s).has_value()) << name << " survived SIGKILL";
-    const auto args = found->args;
+    if (args != nullptr) *args = found->args;
     children_.erase(found);
-    start(name, args);
   }
   /// SIGTERM to everyone, newest first; each must exit 0.
   void stop() {
@@ -678,6 +683,34 @@ TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTh
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
+TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesAndTheOperatorIsTold) {
+  constexpr std::uint32_t kDomain = 46;
+  Fleet fleet(kDomain, "logical-gone");
+  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
+  ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("V1"));
+
+  // Ten seconds without a heartbeat (the topology agent's default), V1's route goes but for
+  // what its vehicle occupies: V2 gets the station V1's route held open-ended.
+  ASSERT_EQ(send_order("V2", "v2-station", {{"right-4", "NOP"}}), "");
+  const auto station = wait_order("v2-station");
+  ASSERT_TRUE(station.has_value()) << "V2's order did not end";
+  EXPECT_EQ(station->state(), msg::ORDER_FINISHED) << station->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  // The vehicle stopped on left-2, where its last move took it: that stays allocated, and
+  // the operator is told so by the topology agent.
+  EXPECT_EQ(seen_.holders["left-2"], "V1");
+  const auto gone = std::find_if(seen_.alarms.begin(), seen_.alarms.end(), [](const msg::OperatorAlarm& alarm) {
+    return alarm.agent() == "topology" && alarm.vehicle() == "V1" && alarm.severity() == msg::ALARM_ERROR &&
+           alarm.text().find("is gone") != std::string::npos && alarm.text().find("'left-2'") != std::string::npos;
+  });
+  EXPECT_NE(gone, seen_.alarms.end()) << "no alarm of the topology agent about V1";
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
 }
 
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {

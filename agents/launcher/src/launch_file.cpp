@@ -99,6 +99,7 @@ const std::vector<KindRules>& kind_rules() {
       {AgentKind::topology, "topology", "topology-agent", "--id", "", false, true,
        {{"partition", "--partition", FieldType::partition},
         {"db", "--db", FieldType::journal},
+        {"departed_after", "--departed-after", FieldType::number},
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::ran_sim, "ran-sim", "ran-sim", "--agent-id", "--id", true, true,
        {{"at", "--at", FieldType::vertex},

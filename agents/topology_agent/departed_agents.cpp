@@ -1,0 +1,180 @@
+// The topology agent's care of logical agents that went away (DESIGN.md "Failure
+// handling"): a logical agent without a heartbeat for departed_after loses its reservations
+// in this partition but for what its vehicle occupies, so that nobody waits behind a route
+// no one drives; the operators are told what it keeps. A logical agent that comes back in
+// time is left alone (its new life takes over itself, docs/logical-agent.md).
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "agents/topology_agent/topology_agent.hpp"
+#include "drover/dds/wire_error.hpp"
+#include "drover/logical_agent/names.hpp"
+
+namespace drover::topology_agent {
+
+namespace {
+/// Real-time budget of one holdings call to another partition's owner.
+constexpr std::chrono::milliseconds kHoldingsTimeout{3000};
+/// How often the departures thread looks for sweeps that are due.
+constexpr std::chrono::milliseconds kDeparturesPeriod{200};
+}  // namespace
+
+Status TopologyAgent::watch_departures() {
+  if (options_.departed_after.count() <= 0) return {};
+  auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, logical_agent::kAlarmTopic,
+                                                        dds::TopicQos::events());
+  if (!alarms) return unexpected(alarms.error());
+  alarm_writer_ = std::move(*alarms);
+  auto holdings = dds::ServiceClient<msg::HoldingsRequest, msg::HoldingsReply>::create(*participant_, kServiceArea,
+                                                                                       "holdings");
+  if (!holdings) return unexpected(holdings.error());
+  holdings_client_ = std::move(*holdings);
+  departed_thread_ = std::thread([this] { run_departures(); });
+  dds::AgentDirectoryOptions watch;
+  watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
+  auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
+  if (!directory) return unexpected(directory.error());
+  directory_ = std::move(*directory);
+  return {};
+}
+
+void TopologyAgent::on_agent_change(const dds::AgentRecord& record) {
+  if (record.kind != "logical") return;
+  std::lock_guard lock(departed_mutex_);
+  if (record.alive) {
+    if (departed_.erase(record.id) > 0) spdlog::info("logical agent '{}' is back", record.id);
+    return;
+  }
+  if (departed_.contains(record.id)) return;
+  spdlog::info("logical agent '{}' lost ({}): its reservations here go in {:.1f} s unless it comes back", record.id,
+               record.lost_reason, std::chrono::duration<double>(options_.departed_after).count());
+  departed_[record.id] = Departure{std::chrono::steady_clock::now() + options_.departed_after, record.lost_reason};
+  departed_wake_.notify_all();
+}
+
+void TopologyAgent::run_departures() {
+  std::unique_lock lock(departed_mutex_);
+  while (!departed_wake_.wait_for(lock, kDeparturesPeriod, [this] { return departed_stop_; })) {
+    const auto now = std::chrono::steady_clock::now();
+    for (auto it = departed_.begin(); it != departed_.end();) {
+      if (it->second.due > now) {
+        ++it;
+        continue;
+      }
+      const auto agent = it->first;
+      const auto why = it->second.why;
+      it = departed_.erase(it);
+      lock.unlock();  // the sweep takes mutex_ and calls other agents
+      sweep_departed(agent, why);
+      lock.lock();
+      it = departed_.upper_bound(agent);  // the map may have changed meanwhile
+    }
+  }
+}
+
+std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> TopologyAgent::held_abroad(
+    const std::string& agent) {
+  std::map<topology::RouteId, std::vector<std::uint32_t>> held;
+  const auto mine = served_partitions();
+  for (const auto& partition : topology_.partitions()) {
+    if (std::find(mine.begin(), mine.end(), partition) != mine.end()) continue;
+    std::optional<std::string> owner;
+    for (const auto& record : directory_->live_agents()) {
+      if (record.kind == "topology" && std::find(record.owns.begin(), record.owns.end(), partition) != record.owns.end()) {
+        owner = record.id;
+      }
+    }
+    if (!owner) {
+      spdlog::warn("what '{}' holds in partition '{}' is unknown: no live topology agent owns it", agent, partition);
+      return std::nullopt;
+    }
+    msg::HoldingsRequest request;
+    request.agent(agent);
+    auto reply = holdings_client_->call(request, kHoldingsTimeout, *owner);
+    if (!reply || !dds::from_wire(reply->error())) {
+      spdlog::warn("what '{}' holds in partition '{}' is unknown: '{}' did not say", agent, partition, *owner);
+      return std::nullopt;
+    }
+    for (const auto& step : reply->held()) held[step.route()].push_back(step.step());
+  }
+  return held;
+}
+
+void TopologyAgent::sweep_departed(const std::string& agent, const std::string& why) {
+  if (directory_) {
+    if (const auto record = directory_->find(agent); record && record->alive) return;  // back just now
+  }
+  const auto abroad = held_abroad(agent);
+  std::vector<std::string> kept;
+  std::size_t routes = 0;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return;
+    const auto here = timelines_.holdings_of(agent);
+    if (here.routes.empty()) return;
+    routes = here.routes.size();
+    // The steps to keep, by route: those held anywhere. Without word from every partition,
+    // every step whose origin another partition owns (it may be held there).
+    std::map<topology::RouteId, std::vector<std::uint32_t>> keep = abroad.value_or(decltype(keep){});
+    if (!abroad) {
+      for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
+        if (!timelines_.owns(entity)) continue;
+        for (const auto& item : timelines_.timeline(entity).reservations) {
+          if (item.agent == agent && !timelines_.owns(item.origin)) keep[item.route].push_back(item.step);
+        }
+      }
+    }
+    std::vector<topology::Grant> grants;
+    std::vector<msg::TopologyEvent> events;
+    for (const auto route : here.routes) {
+      auto& steps = keep[route];
+      std::sort(steps.begin(), steps.end());
+      steps.erase(std::unique(steps.begin(), steps.end()), steps.end());
+      auto cancelled = timelines_.cancel_route(agent, route, steps);
+      if (!cancelled) {
+        spdlog::warn("route {} of departed '{}' not cancelled: {}", route, agent, cancelled.error().message);
+        continue;
+      }
+      grants.insert(grants.end(), cancelled->begin(), cancelled->end());
+      std::erase_if(prepared_, [&](const auto& entry) {
+        return entry.second.agent == agent && entry.second.route == route;
+      });
+      msg::TopologyEvent event;
+      event.kind(msg::EVENT_CANCELLED);
+      event.agent(agent);
+      event.route(route);
+      events.push_back(std::move(event));
+    }
+    if (auto saved = after_change(grants, std::move(events)); !saved) {
+      spdlog::error("the routes of departed '{}' were cancelled but not saved: {}", agent, saved.error().message);
+      return;
+    }
+    for (const auto& [entity, step] : timelines_.holdings_of(agent).held) kept.push_back(topology_.id(entity));
+  }
+  const std::string where = fmt::format("partition(s) {}", fmt::join(served_partitions(), ", "));
+  msg::OperatorAlarm alarm;
+  alarm.agent(agent_id());
+  alarm.vehicle(agent);
+  alarm.time().ns(clock_.now());
+  if (kept.empty()) {
+    alarm.severity(msg::ALARM_WARNING);
+    alarm.text(fmt::format("logical agent '{}' is gone ({}): its {} route(s) in {} are cancelled", agent, why, routes,
+                           where));
+  } else {
+    // Its vehicle stands (or stood) there, driven by nobody: an operator must see to it.
+    alarm.severity(msg::ALARM_ERROR);
+    alarm.text(fmt::format("logical agent '{}' is gone ({}): its vehicle keeps '{}' allocated in {} until its agent "
+                           "comes back; the rest of its {} route(s) there is cancelled",
+                           agent, why, fmt::join(kept, "', '"), where, routes));
+  }
+  spdlog::log(kept.empty() ? spdlog::level::warn : spdlog::level::err, "alarm: {}", alarm.text());
+  if (auto written = alarm_writer_->write(alarm); !written) {
+    spdlog::warn("alarm not published: {}", written.error().message);
+  }
+}
+
+}  // namespace drover::topology_agent
