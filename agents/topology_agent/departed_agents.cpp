@@ -131,6 +131,7 @@ void TopologyAgent::sweep_departed(const std::string& agent, const std::string& 
     std::vector<topology::Grant> grants;
     std::vector<msg::TopologyEvent> events;
     for (const auto route : here.routes) {
+      remember_withdrawn(agent, route);
       auto& steps = keep[route];
       std::sort(steps.begin(), steps.end());
       steps.erase(std::unique(steps.begin(), steps.end()), steps.end());

@@ -240,6 +240,12 @@ Result<topology::EntityIndex> TopologyAgent::owned_entity(const std::string& id)
 void TopologyAgent::on_prepare(const msg::ReservePrepareRequest& request,
                                dds::ReplyHandle<msg::ReservePrepareReply> reply) {
   std::lock_guard lock(mutex_);
+  if (withdrawn_.contains({request.agent(), request.route()})) {
+    // A routing agent retrying a route whose requester gave it up (it cancelled the route,
+    // or crashed and its next life did): reserved now, nobody would ever cancel it.
+    return send_error(reply, Error{ErrorCode::not_permitted, "route " + std::to_string(request.route()) + " of '" +
+                                                                 request.agent() + "' was cancelled by its agent"});
+  }
   std::vector<topology::Reservation> items;
   std::vector<topology::EntityIndex> touched;
   for (const auto& wire_item : request.items()) {
@@ -515,6 +521,9 @@ void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<
 
 void TopologyAgent::on_cancel_route(const msg::CancelRouteRequest& request, StatusHandle reply) {
   std::lock_guard lock(mutex_);
+  // Given up by its own agent (not undone by a routing agent, which re-plans it): never
+  // reserved again, also when nothing of it is here yet (a prepare still on its way).
+  if (reply.requester() == request.agent()) remember_withdrawn(request.agent(), request.route());
   auto grants = timelines_.cancel_route(request.agent(), request.route(), request.held_steps());
   if (!grants) return send_error(reply, grants.error());
   std::erase_if(prepared_, [&](const auto& entry) {
@@ -545,6 +554,15 @@ void TopologyAgent::on_holdings(const msg::HoldingsRequest& request, dds::ReplyH
     out.routes(holdings.routes);
   }
   send_reply(reply, std::move(out));
+}
+
+void TopologyAgent::remember_withdrawn(const std::string& agent, topology::RouteId route) {
+  if (!withdrawn_.insert({agent, route}).second) return;
+  withdrawn_order_.emplace_back(agent, route);
+  if (withdrawn_order_.size() > kWithdrawnKept) {
+    withdrawn_.erase(withdrawn_order_.front());
+    withdrawn_order_.pop_front();
+  }
 }
 
 void TopologyAgent::run_expiry() {

@@ -9,7 +9,9 @@
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <deque>
 #include <map>
+#include <set>
 #include <optional>
 #include <memory>
 #include <mutex>
@@ -151,6 +153,9 @@ class TopologyAgent {
   /// Whether `agent`'s first committed real reservation on `entity` is step 0 of its route
   /// (where the vehicle stands when it planned). Requires mutex_ held.
   bool first_step_of_route(topology::EntityIndex entity, const std::string& agent) const;
+  /// Remembers that `agent` gave up `route` (the last kWithdrawnKept such routes): later
+  /// prepares of it are refused. Requires mutex_ held.
+  void remember_withdrawn(const std::string& agent, topology::RouteId route);
   Status after_change(const std::vector<topology::Grant>& grants, std::vector<msg::TopologyEvent> events = {},
                       bool notify_grants = true);
   void notify(msg::ReservationNotice notice);
@@ -189,6 +194,10 @@ class TopologyAgent {
     std::vector<topology::Reservation> real_items;  // its real reservations, as prepared
   };
   std::map<topology::PrepareId, PreparedRoute> prepared_;  // to tell owners of expired holds
+  /// Routes their own agent cancelled (remember_withdrawn), oldest first in withdrawn_order_.
+  static constexpr std::size_t kWithdrawnKept = 65536;
+  std::set<std::pair<std::string, topology::RouteId>> withdrawn_;
+  std::deque<std::pair<std::string, topology::RouteId>> withdrawn_order_;
   std::vector<StatusHandle> unanswered_commits_;            // drop_commit_replies
   /// Allocation requests with wait = true that are queued: answered when granted.
   std::multimap<std::pair<std::string, topology::EntityIndex>, AllocateHandle> waiting_replies_;

@@ -660,6 +660,37 @@ TEST_F(TopologyAgentTest, TwoPartitionsAreServedByTwoAgents) {
   }
 }
 
+// A route its own agent cancelled (it gave it up, or crashed and its next life did) is never
+// reserved again: a routing agent still retrying it would leave a route nobody cancels. One
+// a routing agent cancelled (it undoes a partial commit and re-plans) may be.
+TEST_F(TopologyAgentTest, ARouteItsOwnAgentCancelledIsNotReservedAgain) {
+  start_agent(67);
+  connect(67);
+  auto v1 = make_participant(67, "v1");
+  ASSERT_NE(v1, nullptr);
+  auto own_cancel = make_client<msg::CancelRouteRequest, msg::StatusReply>(*v1, "cancel_route");
+  msg::CancelRouteRequest give_up;
+  give_up.agent("v1");
+  give_up.route(5);  // nothing of it here yet: its prepare is still on its way
+  auto given_up = own_cancel->call(give_up, kDiscoveryTimeout);
+  ASSERT_TRUE(given_up.has_value()) << given_up.error().message;
+  EXPECT_EQ(given_up->error().code(), msg::ERROR_NOT_FOUND);
+  auto late = prepare_->call(prepare_request("v1", 5, items("v1", 5, {{"a", {1000, 2000}}})), kDiscoveryTimeout);
+  ASSERT_TRUE(late.has_value()) << late.error().message;
+  EXPECT_EQ(late->error().code(), msg::ERROR_NOT_PERMITTED) << late->error().message();
+
+  reserve("v1", 6, {{"a", {1000, 2000}}});
+  msg::CancelRouteRequest undo;  // from "tester", as a routing agent undoing a commit
+  undo.agent("v1");
+  undo.route(6);
+  auto undone = cancel_->call(undo, kDiscoveryTimeout);
+  ASSERT_TRUE(undone.has_value()) << undone.error().message;
+  EXPECT_EQ(undone->error().code(), msg::ERROR_NONE) << undone->error().message();
+  reserve("v1", 6, {{"a", {1000, 2000}}});
+  own_cancel.reset();
+  v1.reset();
+}
+
 TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
   start_agent(76);
   connect(76);

@@ -685,6 +685,33 @@ TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTh
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
 }
 
+TEST_F(FleetTest, AStartingLogicalAgentHoldsItsVertexThoughAPartitionNeverAnswers) {
+  constexpr std::uint32_t kDomain = 47;
+  Fleet fleet(kDomain, "silent-partition");
+  // The H crossing in partition "west", and an island of its own in partition "east", which
+  // no topology agent serves (one that is down, or that this host never discovers).
+  auto json = nlohmann::json::parse(std::ifstream(source_dir() + "/launch/topologies/h_crossing.json"));
+  for (auto& vertex : json["vertices"]) vertex["partition"] = "west";
+  for (auto& edge : json["edges"]) edge["partition"] = "west";
+  auto island = json["vertices"][0];
+  island["id"] = "island";
+  island["partition"] = "east";
+  island["x"] = 40;
+  island["y"] = 40;
+  island.erase("kind");
+  json["vertices"].push_back(island);
+  const auto file = (fleet.dir() / "h_island.json").string();
+  std::ofstream(file) << json.dump(2);
+  fleet.use_topology(file);
+  fleet.start("topology", {"topology-agent", "--topology", file, "--partition", "west"});
+  fleet.start("routing", {"routing-agent"});
+  watch(kDomain, fleet, {"V1"});
+  fleet.start_vehicle("V1", "left-0");
+  // Asking every partition what an earlier life left gives up on "east" after a few seconds:
+  // the vehicle's vertex must not stay unprotected for as long as a partition is silent.
+  EXPECT_TRUE(wait_ready("V1", "left-0")) << "V1 never held its vertex";
+}
+
 TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesAndTheOperatorIsTold) {
   constexpr std::uint32_t kDomain = 46;
   Fleet fleet(kDomain, "logical-gone");

@@ -532,8 +532,10 @@ void LogicalAgent::note_allocation_wait(topology::EntityIndex entity) {
   if (!allocation_wait_ || allocation_wait_->entity != entity) allocation_wait_ = AllocationWait{entity, now, false};
   if (allocation_wait_->told || options_.wait_alarm <= 0 || now - allocation_wait_->since < options_.wait_alarm) return;
   const auto& id = topology_->id(entity);
-  raise_alarm(msg::ALARM_WARNING, fmt::format("vehicle '{}' has waited {} for '{}': the vehicle due there before it "
-                                              "does not move on ('droverctl timeline {}' shows who)",
+  // The reply does not say why (a vehicle due there first that does not move on, a lock, an
+  // owner out of reach): the timeline does.
+  raise_alarm(msg::ALARM_WARNING, fmt::format("vehicle '{}' has waited {} for '{}' ('droverctl timeline {}' shows "
+                                              "who holds it, who comes first and its locks)",
                                               vehicle_id(), seconds_text(now - allocation_wait_->since), id, id));
   allocation_wait_->told = true;
 }

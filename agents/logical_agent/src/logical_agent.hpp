@@ -125,6 +125,8 @@ class LogicalAgent {
   /// (leftovers of an earlier route: hold_position swaps the vertex under the vehicle onto
   /// its hold and releases the rest once the footprint leaves it); every route it left is
   /// cancelled but for those allocations, so that nobody waits behind a route no one drives.
+  /// Waits a few seconds at most for the topology agents (the vehicle is not protected by a
+  /// hold until then): what was left in a partition that did not answer stays.
   /// \return false only when stopping before the topology agents answered.
   bool take_over();
   /// Whether commands this life did not give (an earlier life's moves) still run on the
@@ -299,6 +301,7 @@ class LogicalAgent {
   std::optional<AllocationWait> allocation_wait_;
   /// Since when commands of an earlier life are seen running (earlier_commands_running).
   std::optional<TimeNs> earlier_commands_since_;
+  bool earlier_commands_cancelled_ = false;  ///< their cancel was sent (once)
   TimeNs clear_way_at_ = 0;         ///< when stranded_on tries to clear the way next
   bool making_way_ = false;                          ///< driving aside: requests wait
   std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked

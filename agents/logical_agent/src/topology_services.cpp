@@ -52,11 +52,12 @@ Result<std::unique_ptr<TopologyServices>> TopologyServices::create(dds::Particip
 }
 
 template <class T>
-Result<T> TopologyServices::retry(const std::function<Result<T>()>& call) const {
+Result<T> TopologyServices::retry(const std::function<Result<T>()>& call,
+                                  std::optional<std::chrono::steady_clock::time_point> give_up) const {
   for (;;) {
     auto result = call();
     if (result || !nobody_answered(result.error())) return result;
-    if (stopping_) return result;
+    if (stopping_ || (give_up && std::chrono::steady_clock::now() >= *give_up)) return result;
     spdlog::warn("{} (retrying)", result.error().message);
     std::this_thread::sleep_for(kRetryPause);
   }
@@ -167,7 +168,9 @@ Result<std::vector<topology::Shift>> TopologyServices::delay(const std::string& 
 }
 
 Status TopologyServices::cancel_route(const std::string& agent, topology::RouteId route,
-                                      const std::vector<std::uint32_t>& held_steps) {
+                                      const std::vector<std::uint32_t>& held_steps,
+                                      std::optional<std::chrono::steady_clock::time_point> give_up) {
+  Status outcome;
   for (const auto& partition : topology_->partitions()) {
     auto done = retry<bool>([&]() -> Result<bool> {
       auto owner = owner_of_partition(partition);
@@ -182,13 +185,13 @@ Status TopologyServices::cancel_route(const std::string& agent, topology::RouteI
         return unexpected(status.error());
       }
       return true;
-    });
-    if (!done) return unexpected(done.error());
+    }, give_up);
+    if (!done && outcome) outcome = unexpected(done.error());
   }
-  return {};
+  return outcome;
 }
 
-Result<Holdings> TopologyServices::holdings(const std::string& agent) {
+Result<Holdings> TopologyServices::holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up) {
   Holdings out;
   for (const auto& partition : topology_->partitions()) {
     auto reply = retry<msg::HoldingsReply>([&]() -> Result<msg::HoldingsReply> {
@@ -200,7 +203,11 @@ Result<Holdings> TopologyServices::holdings(const std::string& agent) {
       if (!answer) return unexpected(answer.error());
       if (auto status = dds::from_wire(answer->error()); !status) return unexpected(status.error());
       return answer;
-    });
+    }, give_up);
+    if (!reply && nobody_answered(reply.error()) && !stopping_) {
+      out.unanswered.push_back(partition);
+      continue;
+    }
     if (!reply) return unexpected(reply.error());
     for (const auto& held : reply->held()) {
       const auto entity = topology_->find(held.entity());

@@ -32,6 +32,7 @@ struct AllocateOutcome {
 struct Holdings {
   std::vector<std::pair<topology::EntityIndex, HeldStep>> held;  ///< the entities it holds
   std::vector<topology::RouteId> routes;  ///< routes it has reservations of, ascending, each once
+  std::vector<std::string> unanswered;    ///< partitions whose owner did not answer in time
 };
 
 /// Thread-safe. Must be destroyed before its Participant.
@@ -63,15 +64,18 @@ class TopologyServices {
   Result<std::vector<topology::Shift>> delay(const std::string& agent, topology::RouteId route,
                                              topology::EntityIndex entity, DurationNs by);
   /// Cancels `route` on every live topology agent (not_found there is fine), retrying the
-  /// ones that do not answer. The route's `held_steps` (allocations the vehicle still
-  /// stands on) stay with their shadows in every partition, to go with their release.
-  /// \return success, or the first other error.
-  Status cancel_route(const std::string& agent, topology::RouteId route, const std::vector<std::uint32_t>& held_steps);
+  /// ones that do not answer (until `give_up`, when given). The route's `held_steps`
+  /// (allocations the vehicle still stands on) stay with their shadows in every partition,
+  /// to go with their release. A partition that fails does not keep the others from it.
+  /// \return success, or the first error.
+  Status cancel_route(const std::string& agent, topology::RouteId route, const std::vector<std::uint32_t>& held_steps,
+                      std::optional<std::chrono::steady_clock::time_point> give_up = std::nullopt);
 
-  /// What `agent` has at the owners of every partition, each asked until it answers.
-  /// Entities the topology does not know are left out (with a warning).
+  /// What `agent` has at the owners of every partition, each asked until it answers or
+  /// `give_up` has passed (then it is listed as unanswered). Entities the topology does not
+  /// know are left out (with a warning).
   /// \return them, or the first other error (unavailable once stopping).
-  Result<Holdings> holdings(const std::string& agent);
+  Result<Holdings> holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up);
 
   /// The live topology agent owning `entity`. \return its id, or unavailable.
   Result<std::string> owner_of(topology::EntityIndex entity) const;
@@ -87,9 +91,11 @@ class TopologyServices {
   TopologyServices(std::shared_ptr<const topology::Topology> topology, std::chrono::milliseconds call_timeout,
                    const std::atomic<bool>& stopping)
       : topology_(std::move(topology)), call_timeout_(call_timeout), stopping_(stopping) {}
-  /// Runs `call` until it returns something else than timeout/unavailable or stopping.
+  /// Runs `call` until it returns something else than timeout/unavailable, or stopping, or
+  /// `give_up` (when given) has passed.
   template <class T>
-  Result<T> retry(const std::function<Result<T>()>& call) const;
+  Result<T> retry(const std::function<Result<T>()>& call,
+                  std::optional<std::chrono::steady_clock::time_point> give_up = std::nullopt) const;
 
   std::shared_ptr<const topology::Topology> topology_;
   std::chrono::milliseconds call_timeout_;
