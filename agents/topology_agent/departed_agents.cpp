@@ -33,12 +33,12 @@ Status TopologyAgent::watch_departures() {
                                                                                        "holdings");
   if (!holdings) return unexpected(holdings.error());
   holdings_client_ = std::move(*holdings);
-  departed_thread_ = std::thread([this] { run_departures(); });
   dds::AgentDirectoryOptions watch;
   watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
   auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
   if (!directory) return unexpected(directory.error());
   directory_ = std::move(*directory);
+  departed_thread_ = std::thread([this] { run_departures(); });  // after directory_: it reads it
   return {};
 }
 

@@ -185,14 +185,15 @@ Status TopologyAgent::start() {
 }
 
 TopologyAgent::~TopologyAgent() {
-  // Departures first: a sweep publishes through the writers and serves no request.
-  directory_.reset();
+  // Departures first (the thread, then the directory it reads): a sweep publishes through
+  // the writers and serves no request.
   {
     std::lock_guard lock(departed_mutex_);
     departed_stop_ = true;
   }
   departed_wake_.notify_all();
   if (departed_thread_.joinable()) departed_thread_.join();
+  directory_.reset();
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
