@@ -425,6 +425,14 @@ class FleetTest : public ::testing::Test {
     ASSERT_TRUE(wait_ready("V2", "right-0"));
   }
 
+  /// The crossing's usual start, then V1 sent to the station right-4 (order v1-lost), until
+  /// it drives. Call through ASSERT_NO_FATAL_FAILURE.
+  void start_v1_towards_the_station(Fleet& fleet, std::uint32_t domain) {
+    ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, domain));
+    ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
+    ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  }
+
   /// After an agent's crash: the crossing orders v1-there and v2-there finish, then a new
   /// order v1-back to left-0 (which needs the restarted agent), with no two footprints
   /// overlapping and no alarm. Call through ASSERT_NO_FATAL_FAILURE.
@@ -655,11 +663,9 @@ TEST_F(FleetTest, OrdersSurviveACrashOfTheTopologyAgent) {
 TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTheRouteItLeft) {
   constexpr std::uint32_t kDomain = 45;
   Fleet fleet(kDomain, "logical-restart");
-  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
   // V1 drives towards right-4, its route reserved over the bar to the station (held there
   // open-ended); its logical agent crashes on the way and is started again.
-  ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
-  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  ASSERT_NO_FATAL_FAILURE(start_v1_towards_the_station(fleet, kDomain));
   fleet.crash_and_restart("V1");
 
   // The new life takes over the vehicle where it stands and gives up the route the old one
@@ -715,9 +721,7 @@ TEST_F(FleetTest, AStartingLogicalAgentHoldsItsVertexThoughAPartitionNeverAnswer
 TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesAndTheOperatorIsTold) {
   constexpr std::uint32_t kDomain = 46;
   Fleet fleet(kDomain, "logical-gone");
-  ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, kDomain));
-  ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
-  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  ASSERT_NO_FATAL_FAILURE(start_v1_towards_the_station(fleet, kDomain));
   ASSERT_NO_FATAL_FAILURE(fleet.crash("V1"));
 
   // Ten seconds without a heartbeat (the topology agent's default), V1's route goes but for
