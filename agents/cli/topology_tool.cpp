@@ -91,13 +91,11 @@ Result<dds::AgentRecord> find_owner(dds::Participant& participant, const std::st
     (*directory)->wait_until(
         [&](const std::vector<dds::AgentRecord>& records) {
           std::lock_guard lock(mutex);
-          for (const auto& record : records) {
-            if (!record.alive || record.kind != "topology") continue;
-            any_topology = true;
-            if (partition && std::find(record.owns.begin(), record.owns.end(), *partition) != record.owns.end()) {
-              owner = record;
-            }
-          }
+          any_topology = any_topology || std::any_of(records.begin(), records.end(), [](const auto& record) {
+                           return record.alive && record.kind == "topology";
+                         });
+          if (!partition) return false;
+          if (const dds::AgentRecord* live = dds::live_owner_among(records, "topology", *partition)) owner = *live;
           return owner.has_value();
         },
         std::chrono::milliseconds(50));

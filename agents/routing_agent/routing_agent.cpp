@@ -224,14 +224,9 @@ Result<std::string> RoutingAgent::owner_of(const std::string& partition) const {
   // owners' first heartbeats arrive: wait for them as for the descriptions.
   const bool found = directory_->wait_until(
       [&](const std::vector<dds::AgentRecord>& agents) {
-        for (const auto& agent : agents) {
-          if (agent.alive && agent.kind == "topology" &&
-              std::find(agent.owns.begin(), agent.owns.end(), partition) != agent.owns.end()) {
-            owner = agent.id;
-            return true;
-          }
-        }
-        return false;
+        const dds::AgentRecord* live = dds::live_owner_among(agents, "topology", partition);
+        if (live) owner = live->id;
+        return live != nullptr;
       },
       options_.learn_timeout);
   if (!found) {

@@ -2,9 +2,12 @@
 // handling"): a logical agent without a heartbeat for departed_after loses its reservations
 // in this partition but for what its vehicle occupies, so that nobody waits behind a route
 // no one drives; the operators are told what it keeps. A logical agent that comes back in
-// time is left alone (its new life takes over itself, docs/logical-agent.md).
+// time is left alone (its new life takes over itself, docs/logical-agent.md). A topology
+// agent restarted from its journal owes the same to the agents it has reservations of: one
+// never heard within departed_after of the start went away while this agent was down.
 
 #include <algorithm>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -33,6 +36,7 @@ Status TopologyAgent::watch_departures() {
                                                                                        "holdings");
   if (!holdings) return unexpected(holdings.error());
   holdings_client_ = std::move(*holdings);
+  owe_heartbeats();  // before the directory: its first word of an agent may come at once
   dds::AgentDirectoryOptions watch;
   watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
   auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
@@ -40,6 +44,24 @@ Status TopologyAgent::watch_departures() {
   directory_ = std::move(*directory);
   departed_thread_ = std::thread([this] { run_departures(); });  // after directory_: it reads it
   return {};
+}
+
+void TopologyAgent::owe_heartbeats() {
+  std::set<std::string> reserving;
+  {
+    std::lock_guard lock(mutex_);
+    for (topology::EntityIndex entity = 0; entity < topology_.entity_count(); ++entity) {
+      if (!timelines_.owns(entity)) continue;
+      for (const auto& item : timelines_.timeline(entity).reservations) reserving.insert(item.agent);
+    }
+  }
+  std::lock_guard lock(departed_mutex_);
+  for (const auto& agent : reserving) {
+    spdlog::info("logical agent '{}' has reservations here from the journal: they go in {:.1f} s unless it is heard",
+                 agent, std::chrono::duration<double>(options_.departed_after).count());
+    departed_[agent] = Departure{std::chrono::steady_clock::now() + options_.departed_after,
+                                 "no heartbeat since this topology agent started"};
+  }
 }
 
 void TopologyAgent::on_agent_change(const dds::AgentRecord& record) {
@@ -82,21 +104,16 @@ std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> TopologyA
   const auto mine = served_partitions();
   for (const auto& partition : topology_.partitions()) {
     if (std::find(mine.begin(), mine.end(), partition) != mine.end()) continue;
-    std::optional<std::string> owner;
-    for (const auto& record : directory_->live_agents()) {
-      if (record.kind == "topology" && std::find(record.owns.begin(), record.owns.end(), partition) != record.owns.end()) {
-        owner = record.id;
-      }
-    }
+    const auto owner = directory_->live_owner_of("topology", partition);
     if (!owner) {
       spdlog::warn("what '{}' holds in partition '{}' is unknown: no live topology agent owns it", agent, partition);
       return std::nullopt;
     }
     msg::HoldingsRequest request;
     request.agent(agent);
-    auto reply = holdings_client_->call(request, kHoldingsTimeout, *owner);
+    auto reply = holdings_client_->call(request, kHoldingsTimeout, owner->id);
     if (!reply || !dds::from_wire(reply->error())) {
-      spdlog::warn("what '{}' holds in partition '{}' is unknown: '{}' did not say", agent, partition, *owner);
+      spdlog::warn("what '{}' holds in partition '{}' is unknown: '{}' did not say", agent, partition, owner->id);
       return std::nullopt;
     }
     for (const auto& step : reply->held()) held[step.route()].push_back(step.step());

@@ -122,6 +122,9 @@ class TopologyAgent {
   // ---- logical agents that went away (departed_agents.cpp) ----
   /// Starts watching the logical agents' heartbeats (with departed_after > 0).
   Status watch_departures();
+  /// Makes a sweep due departed_after from now for every agent with reservations here (a
+  /// journal's), called off by its first heartbeat (on_agent_change).
+  void owe_heartbeats();
   /// From the directory's thread: a logical agent died (its sweep is due departed_after
   /// later) or came back (nothing is due).
   void on_agent_change(const dds::AgentRecord& record);

@@ -1,5 +1,5 @@
 // The topology agent as a process (`drover topology-agent`): the test process is its
-// client over DDS. Domains 60, 66 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
+// client over DDS. Domains 60, 66..68 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 
@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "agents/topology_agent/topology_agent.hpp"
+#include "agents/logical_agent/src/topology_services.hpp"
 #include "agents/topology_agent/wire.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
@@ -760,6 +761,45 @@ TEST_F(TopologyAgentTest, AfterKill9TheRestartedAgentHasItsCommittedStateBack) {
   std::filesystem::remove(journal);
   std::filesystem::remove(journal.string() + "-wal");
   std::filesystem::remove(journal.string() + "-shm");
+}
+
+// The logical agent's side of a cancel (TopologyServices, as its executor uses it): a
+// partition's owner that is down is not waited for, and the cancel reaches its next life.
+TEST_F(TopologyAgentTest, ACancelSentWhileTheOwnerWasDownReachesItsNextLife) {
+  const auto journal = std::filesystem::path(topology_file_).replace_extension(".cancel.db");
+  std::filesystem::remove(journal);
+  start_agent(68, {"--db", journal.string()});
+  connect(68);
+  reserve("v1", 1, {{"a", {1000, 2000}}});
+  ASSERT_FALSE(timeline("a").reservations().empty());
+  agents_.back().signal(SIGKILL);
+  ASSERT_TRUE(agents_.back().wait_exit(kDiscoveryTimeout).has_value());
+  agents_.pop_back();
+
+  auto v1 = make_participant(68, "v1");
+  ASSERT_NE(v1, nullptr);
+  const std::atomic<bool> stopping{false};
+  auto services = logical_agent::TopologyServices::create(*v1, std::make_shared<topology::Topology>(*topology_),
+                                                          std::chrono::milliseconds(1000), stopping);
+  ASSERT_TRUE(services.has_value()) << services.error().message;
+  const std::vector<topology::RouteStep> steps{{*topology_->find("a"), {1000, 2000}}};
+  const auto touched = (*services)->partitions_touched(steps);
+  EXPECT_EQ(touched, std::vector<std::string>{"west"});  // "a" and its shadows on a-b
+  // Returns at once, the cancel left due: nobody owns "west" now.
+  EXPECT_TRUE((*services)->cancel_route("v1", 1, {}, touched).has_value());
+  EXPECT_EQ((*services)->cancels_due(), 1u);
+
+  {
+    std::lock_guard guard(mutex_);
+    timelines_.clear();
+  }
+  start_agent(68, {"--db", journal.string()});
+  EXPECT_TRUE(wait_until([&] { return timelines_.count("a") > 0 && timelines_["a"].reservations().empty(); }))
+      << "the restarted agent kept route 1";
+  EXPECT_TRUE(wait_until([&] { return (*services)->cancels_due() == 0; }));
+  services->reset();
+  v1.reset();
+  for (const auto* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(journal.string() + suffix);
 }
 
 TEST(TopologyAgentCommand, APartitionThatOwnsNothingIsBadInput) {

@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 45..48, 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -425,10 +425,11 @@ class FleetTest : public ::testing::Test {
     ASSERT_TRUE(wait_ready("V2", "right-0"));
   }
 
-  /// The crossing's usual start, then V1 sent to the station right-4 (order v1-lost), until
-  /// it drives. Call through ASSERT_NO_FATAL_FAILURE.
-  void start_v1_towards_the_station(Fleet& fleet, std::uint32_t domain) {
-    ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, domain));
+  /// The crossing's usual start (the topology agent journaling to `journal` when given),
+  /// then V1 sent to the station right-4 (order v1-lost), until it drives. Call through
+  /// ASSERT_NO_FATAL_FAILURE.
+  void start_v1_towards_the_station(Fleet& fleet, std::uint32_t domain, const std::string& journal = {}) {
+    ASSERT_NO_FATAL_FAILURE(start_two_vehicles(fleet, domain, journal));
     ASSERT_EQ(send_order("V1", "v1-lost", {{"right-4", "NOP"}}), "");
     ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
   }
@@ -691,7 +692,7 @@ TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTh
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
 }
 
-TEST_F(FleetTest, AStartingLogicalAgentHoldsItsVertexThoughAPartitionNeverAnswers) {
+TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNoLiveOwner) {
   constexpr std::uint32_t kDomain = 47;
   Fleet fleet(kDomain, "silent-partition");
   // The H crossing in partition "west", and an island of its own in partition "east", which
@@ -715,7 +716,15 @@ TEST_F(FleetTest, AStartingLogicalAgentHoldsItsVertexThoughAPartitionNeverAnswer
   fleet.start_vehicle("V1", "left-0");
   // Asking every partition what an earlier life left gives up on "east" after a few seconds:
   // the vehicle's vertex must not stay unprotected for as long as a partition is silent.
-  EXPECT_TRUE(wait_ready("V1", "left-0")) << "V1 never held its vertex";
+  ASSERT_TRUE(wait_ready("V1", "left-0")) << "V1 never held its vertex";
+  // Each new route cancels the one before (its remnant) where that one was reserved: in
+  // "west" only, so a partition nobody serves holds up no order.
+  for (const auto& [order, to] : {std::pair{"there", "right-4"}, std::pair{"back", "left-0"}}) {
+    ASSERT_EQ(send_order("V1", order, {{to, "NOP"}}), "");
+    const auto ended = wait_order(order);
+    ASSERT_TRUE(ended.has_value()) << "order " << order << " did not end";
+    EXPECT_EQ(ended->state(), msg::ORDER_FINISHED) << order << ": " << ended->failure();
+  }
 }
 
 TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesAndTheOperatorIsTold) {
@@ -738,6 +747,32 @@ TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOcc
   const auto gone = std::find_if(seen_.alarms.begin(), seen_.alarms.end(), [](const msg::OperatorAlarm& alarm) {
     return alarm.agent() == "topology" && alarm.vehicle() == "V1" && alarm.severity() == msg::ALARM_ERROR &&
            alarm.text().find("is gone") != std::string::npos && alarm.text().find("'left-2'") != std::string::npos;
+  });
+  EXPECT_NE(gone, seen_.alarms.end()) << "no alarm of the topology agent about V1";
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+}
+
+TEST_F(FleetTest, ATopologyAgentRestartedFromItsJournalSweepsALogicalAgentThatWentAwayWhileItWasDown) {
+  constexpr std::uint32_t kDomain = 48;
+  Fleet fleet(kDomain, "gone-while-down");
+  ASSERT_NO_FATAL_FAILURE(start_v1_towards_the_station(fleet, kDomain, "topology.db"));
+  // The topology agent goes down, and V1's logical agent with it, for good: the next life
+  // of the topology agent never hears V1, yet its journal has V1's route to the station.
+  std::vector<std::string> topology_args;
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("topology", &topology_args));
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("V1"));
+  fleet.start("topology", topology_args);
+
+  ASSERT_EQ(send_order("V2", "v2-station", {{"right-4", "NOP"}}), "");
+  const auto station = wait_order("v2-station");
+  ASSERT_TRUE(station.has_value()) << "V2's order did not end";
+  EXPECT_EQ(station->state(), msg::ORDER_FINISHED) << station->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  const auto gone = std::find_if(seen_.alarms.begin(), seen_.alarms.end(), [](const msg::OperatorAlarm& alarm) {
+    return alarm.agent() == "topology" && alarm.vehicle() == "V1" &&
+           alarm.text().find("no heartbeat since this topology agent started") != std::string::npos;
   });
   EXPECT_NE(gone, seen_.alarms.end()) << "no alarm of the topology agent about V1";
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();

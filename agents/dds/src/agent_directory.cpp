@@ -13,6 +13,15 @@ namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::rtps::GuidPrefix_t;
 using eprosima::fastrtps::rtps::InstanceHandle_t;
 
+const AgentRecord* live_owner_among(const std::vector<AgentRecord>& records, std::string_view kind,
+                                    std::string_view partition) {
+  const auto owner = std::find_if(records.begin(), records.end(), [&](const AgentRecord& record) {
+    return record.alive && record.kind == kind &&
+           std::find(record.owns.begin(), record.owns.end(), partition) != record.owns.end();
+  });
+  return owner == records.end() ? nullptr : &*owner;
+}
+
 AgentDirectory::AgentDirectory(Participant& participant, AgentDirectoryOptions options)
     : participant_(participant), options_(std::move(options)) {}
 
@@ -143,6 +152,13 @@ std::optional<AgentRecord> AgentDirectory::find(const std::string& id) const {
   std::lock_guard lock(mutex_);
   if (auto it = entries_.find(id); it != entries_.end()) return it->second.record;
   return std::nullopt;
+}
+
+std::optional<AgentRecord> AgentDirectory::live_owner_of(std::string_view kind, std::string_view partition) const {
+  std::lock_guard lock(mutex_);
+  std::vector<AgentRecord> records = agents_locked();
+  const AgentRecord* owner = live_owner_among(records, kind, partition);
+  return owner ? std::optional<AgentRecord>(*owner) : std::nullopt;
 }
 
 bool AgentDirectory::wait_until(const std::function<bool(const std::vector<AgentRecord>&)>& predicate,

@@ -108,7 +108,8 @@ void LogicalAgent::run() {
   // reservations go; what the vehicle occupies stays allocated.
   stop_vehicle();
   if (route_) {
-    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id(), monitor_.held_steps_of(route_->id()));
+    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id(), monitor_.held_steps_of(route_->id()),
+                                                 services_->partitions_touched(route_->steps()));
         !cancelled) {
       spdlog::warn("route {} not cancelled on shutdown: {}", route_->id(), cancelled.error().message);
     } else {
@@ -344,7 +345,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   // old one held the vertex since the vehicle arrived).
   if (monitor_.holds(here)) {
     if (auto released = services_->release(vehicle_id(), here, monitor_.granted_as(here)); !released) {
-      cancel_route_quietly(next.id());  // nothing was handed over: the new route must not stay reserved
+      cancel_route_quietly(next);  // nothing was handed over: the new route must not stay reserved
       return released;
     }
     monitor_.drop(here);
@@ -359,7 +360,7 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     std::unique_lock lock(mutex_);
     wake_.wait_for(lock, options_.tick, [&] { return stopping_.load(); });
   }
-  if (route_ && route_->id() != next.id()) cancel_route_quietly(route_->id());
+  if (route_ && route_->id() != next.id()) cancel_route_quietly(*route_);
   remnant_.reset();  // what it held of the vertex is handed over above; the rest is passed
   if (next.size() > 1) {
     std::lock_guard lock(mutex_);
@@ -404,7 +405,7 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
         // The rest of the route goes now, but for what the vehicle holds: those due after it
         // there need not wait for it, and while it waits for a new route only the vertex it
         // stands on is kept reserved (keep_standing_reserved).
-        cancel_route_quietly(route_->id());
+        cancel_route_quietly(*route_);
         continue;
       case FollowResult::failed:
         abandon_route();
@@ -757,11 +758,19 @@ void LogicalAgent::cancel_route_quietly(topology::RouteId route) {
   }
 }
 
+void LogicalAgent::cancel_route_quietly(const RouteTracker& route) {
+  if (auto cancelled = services_->cancel_route(vehicle_id(), route.id(), monitor_.held_steps_of(route.id()),
+                                               services_->partitions_touched(route.steps()));
+      !cancelled) {
+    spdlog::warn("route {} not cancelled: {}", route.id(), cancelled.error().message);
+  }
+}
+
 void LogicalAgent::abandon_route() {
   if (!route_) return;
   const bool stands = stop_vehicle();  // before anything is released
   // The steps the vehicle holds stay reserved; the rest of the route goes.
-  cancel_route_quietly(route_->id());
+  cancel_route_quietly(*route_);
   monitor_.forget_steps();
   if (const auto status = latest_status(); status && stands) {
     for (const auto entity : monitor_.releasable(status->footprint, 0)) {

@@ -209,8 +209,12 @@ class LogicalAgent {
   /// releases what the footprint does not need (otherwise hold_position does, later). The
   /// route becomes remnant_.
   void abandon_route();
-  /// Cancels a route of ours on every topology agent; failures are logged.
+  /// Cancels a route of ours whose steps are unknown (a reply lost, or not to be trusted)
+  /// in every partition; failures are logged.
   void cancel_route_quietly(topology::RouteId route);
+  /// Cancels `route` where it has reservations (TopologyServices::partitions_touched);
+  /// failures are logged.
+  void cancel_route_quietly(const RouteTracker& route);
   void release_passed(const ran::VehicleStatus& status);
   void process_notices(bool& replan);
   /// The allocation of `entity` was not granted (yet): raises the wait_alarm warning once

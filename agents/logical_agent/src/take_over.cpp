@@ -44,7 +44,7 @@ bool LogicalAgent::take_over() {
   spdlog::warn("taking over from an earlier life of '{}': it holds [{}] and left {} route(s) reserved, now cancelled",
                vehicle_id(), fmt::join(held_ids, ", "), holdings->routes.size());
   for (const auto route : holdings->routes) {
-    if (auto cancelled = services_->cancel_route(vehicle_id(), route, monitor_.held_steps_of(route), give_up);
+    if (auto cancelled = services_->cancel_route(vehicle_id(), route, monitor_.held_steps_of(route));
         !cancelled) {
       spdlog::warn("route {} of an earlier life not cancelled everywhere: {}", route, cancelled.error().message);
     }

@@ -16,6 +16,11 @@ constexpr const char* kTopologyArea = "topology";
 constexpr const char* kRoutingArea = "routing";
 /// Pause between retries of a call nobody answered.
 constexpr std::chrono::milliseconds kRetryPause{200};
+/// Pause between rounds of the cancels still due (TopologyServices::cancel_route).
+constexpr std::chrono::seconds kDueCancelPause{1};
+/// Bound on the cancels kept due: a partition that never gets an owner must not make the
+/// list grow for ever.
+constexpr std::size_t kMostCancelsDue = 4096;
 
 bool nobody_answered(const Error& error) {
   return error.code == ErrorCode::timeout || error.code == ErrorCode::unavailable;
@@ -48,6 +53,7 @@ Result<std::unique_ptr<TopologyServices>> TopologyServices::create(dds::Particip
                       make_client(services->holdings_client_, participant, kTopologyArea, "holdings")}) {
     if (!status) return unexpected(status.error());
   }
+  services->due_sender_ = std::thread([raw = services.get()] { raw->send_due_cancels(); });
   return services;
 }
 
@@ -70,11 +76,7 @@ Result<std::string> TopologyServices::owner_of(topology::EntityIndex entity) con
 }
 
 Result<std::string> TopologyServices::owner_of_partition(const std::string& partition) const {
-  for (const auto& agent : directory_->live_agents()) {
-    if (agent.kind == "topology" && std::find(agent.owns.begin(), agent.owns.end(), partition) != agent.owns.end()) {
-      return agent.id;
-    }
-  }
+  if (auto owner = directory_->live_owner_of("topology", partition)) return owner->id;
   return fail(ErrorCode::unavailable, "no live topology agent owns partition '" + partition + "'");
 }
 
@@ -169,26 +171,115 @@ Result<std::vector<topology::Shift>> TopologyServices::delay(const std::string& 
 
 Status TopologyServices::cancel_route(const std::string& agent, topology::RouteId route,
                                       const std::vector<std::uint32_t>& held_steps,
-                                      std::optional<std::chrono::steady_clock::time_point> give_up) {
+                                      const std::vector<std::string>& partitions) {
   Status outcome;
-  for (const auto& partition : topology_->partitions()) {
-    auto done = retry<bool>([&]() -> Result<bool> {
-      auto owner = owner_of_partition(partition);
-      if (!owner) return unexpected(owner.error());
-      msg::CancelRouteRequest request;
-      request.agent(agent);
-      request.route(route);
-      request.held_steps(held_steps);
-      auto reply = cancel_client_->call(request, call_timeout_, *owner);
-      if (!reply) return unexpected(reply.error());
-      if (auto status = dds::from_wire(reply->error()); !status && status.error().code != ErrorCode::not_found) {
-        return unexpected(status.error());
-      }
-      return true;
-    }, give_up);
-    if (!done && outcome) outcome = unexpected(done.error());
+  for (const auto& partition : partitions.empty() ? topology_->partitions() : partitions) {
+    DueCancel cancel{agent, route, held_steps, partition};
+    auto sent = send_cancel(cancel);
+    if (!sent && nobody_answered(sent.error())) {
+      spdlog::warn("route {} not cancelled in partition '{}' yet: {} (sent again once its owner answers)", route,
+                   partition, sent.error().message);
+      keep_due(std::move(cancel));
+      continue;
+    }
+    if (!sent && outcome) outcome = unexpected(sent.error());
   }
   return outcome;
+}
+
+Status TopologyServices::send_cancel(const DueCancel& cancel) const {
+  auto owner = owner_of_partition(cancel.partition);
+  if (!owner) return unexpected(owner.error());
+  msg::CancelRouteRequest request;
+  request.agent(cancel.agent);
+  request.route(cancel.route);
+  request.held_steps(cancel.held_steps);
+  auto reply = cancel_client_->call(request, call_timeout_, *owner);
+  if (!reply) return unexpected(reply.error());
+  if (auto status = dds::from_wire(reply->error()); !status && status.error().code != ErrorCode::not_found) {
+    return status;
+  }
+  return {};
+}
+
+void TopologyServices::keep_due(DueCancel cancel) {
+  std::lock_guard lock(due_mutex_);
+  const auto same = std::find_if(due_.begin(), due_.end(), [&](const DueCancel& due) {
+    return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
+  });
+  if (same != due_.end()) {
+    *same = std::move(cancel);
+  } else if (due_.size() >= kMostCancelsDue) {
+    spdlog::error("{} route cancels are due; route {} is not cancelled in partition '{}' (its topology agent keeps "
+                  "it until this agent is gone)",
+                  due_.size(), cancel.route, cancel.partition);
+  } else {
+    due_.push_back(std::move(cancel));
+  }
+  due_wake_.notify_all();
+}
+
+std::size_t TopologyServices::cancels_due() const {
+  std::lock_guard lock(due_mutex_);
+  return due_.size();
+}
+
+void TopologyServices::send_due_cancels() {
+  std::unique_lock lock(due_mutex_);
+  while (!closing_) {
+    due_wake_.wait_for(lock, kDueCancelPause, [&] { return closing_.load(); });
+    // Calls go out unlocked: cancel_route may add to the list meanwhile.
+    std::vector<DueCancel> due = std::move(due_);
+    due_.clear();
+    lock.unlock();
+    std::vector<DueCancel> still_due;
+    for (auto& cancel : due) {
+      // Not sent while the agent stops: a call may take call_timeout, and the destructor waits.
+      if (stopping_ || closing_ || !directory_->live_owner_of("topology", cancel.partition)) {
+        still_due.push_back(std::move(cancel));
+        continue;
+      }
+      if (auto sent = send_cancel(cancel); !sent && nobody_answered(sent.error())) {
+        still_due.push_back(std::move(cancel));
+      } else if (!sent) {
+        spdlog::warn("route {} not cancelled in partition '{}': {}", cancel.route, cancel.partition,
+                     sent.error().message);
+      } else {
+        spdlog::info("route {} cancelled in partition '{}' (was due)", cancel.route, cancel.partition);
+      }
+    }
+    lock.lock();
+    // Newer cancels of the same route and partition, added meanwhile, stand.
+    for (auto& cancel : still_due) {
+      const bool newer = std::any_of(due_.begin(), due_.end(), [&](const DueCancel& due) {
+        return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
+      });
+      if (!newer) due_.push_back(std::move(cancel));
+    }
+  }
+  for (const auto& cancel : due_) {
+    spdlog::warn("route {} left reserved in partition '{}': its owner never answered the cancel (it goes once the "
+                 "topology agent finds this agent gone)",
+                 cancel.route, cancel.partition);
+  }
+}
+
+TopologyServices::~TopologyServices() {
+  {
+    std::lock_guard lock(due_mutex_);
+    closing_ = true;
+  }
+  due_wake_.notify_all();
+  if (due_sender_.joinable()) due_sender_.join();
+}
+
+std::vector<std::string> TopologyServices::partitions_touched(const std::vector<topology::RouteStep>& steps) const {
+  std::set<std::string> touched;
+  for (const auto& step : steps) {
+    touched.insert(topology_->partition(step.entity));
+    for (const auto member : topology_->conflicts(step.entity)) touched.insert(topology_->partition(member));
+  }
+  return {touched.begin(), touched.end()};
 }
 
 Result<Holdings> TopologyServices::holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up) {

@@ -6,9 +6,12 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "drover/common/result.hpp"
@@ -38,6 +41,8 @@ struct Holdings {
 /// Thread-safe. Must be destroyed before its Participant.
 class TopologyServices {
  public:
+  ~TopologyServices();
+
   /// \param stopping  read before every retry: once true, calls give up with unavailable.
   static Result<std::unique_ptr<TopologyServices>> create(dds::Participant& participant,
                                                           std::shared_ptr<const topology::Topology> topology,
@@ -63,13 +68,23 @@ class TopologyServices {
   /// owner's error.
   Result<std::vector<topology::Shift>> delay(const std::string& agent, topology::RouteId route,
                                              topology::EntityIndex entity, DurationNs by);
-  /// Cancels `route` on every live topology agent (not_found there is fine), retrying the
-  /// ones that do not answer (until `give_up`, when given). The route's `held_steps`
-  /// (allocations the vehicle still stands on) stay with their shadows in every partition,
-  /// to go with their release. A partition that fails does not keep the others from it.
-  /// \return success, or the first error.
+  /// Cancels `route` at the owners of `partitions` (every partition of the topology when
+  /// empty: a route whose steps are unknown); not_found there is fine. The route's
+  /// `held_steps` (allocations the vehicle still stands on) stay with their shadows, to go
+  /// with their release. Each owner is asked once: a partition without a live owner, or
+  /// whose owner does not answer, is not waited for (a vehicle must not stand still because
+  /// a topology agent it does not need is down); the cancel stays due and is sent again in
+  /// the background, every second while the partition has a live owner, until one answers
+  /// (a topology agent restarted from its journal still has the route). A partition that
+  /// fails does not keep the others from it.
+  /// \return success (a cancel left due counts), or the first error an owner answered.
   Status cancel_route(const std::string& agent, topology::RouteId route, const std::vector<std::uint32_t>& held_steps,
-                      std::optional<std::chrono::steady_clock::time_point> give_up = std::nullopt);
+                      const std::vector<std::string>& partitions = {});
+  /// The partitions where a route over `steps` has reservations: those of its entities and
+  /// of the members of their conflict sets (the shadows), each once.
+  std::vector<std::string> partitions_touched(const std::vector<topology::RouteStep>& steps) const;
+  /// How many (route, partition) cancels are still due (see cancel_route).
+  std::size_t cancels_due() const;
 
   /// What `agent` has at the owners of every partition, each asked until it answers or
   /// `give_up` has passed (then it is listed as unanswered). Entities the topology does not
@@ -88,9 +103,24 @@ class TopologyServices {
   template <class Req, class Rep>
   using Client = std::unique_ptr<dds::ServiceClient<Req, Rep>>;
 
+  /// A cancel of one route in one partition, not yet answered.
+  struct DueCancel {
+    std::string agent;
+    topology::RouteId route = 0;
+    std::vector<std::uint32_t> held_steps;
+    std::string partition;
+  };
+
   TopologyServices(std::shared_ptr<const topology::Topology> topology, std::chrono::milliseconds call_timeout,
                    const std::atomic<bool>& stopping)
       : topology_(std::move(topology)), call_timeout_(call_timeout), stopping_(stopping) {}
+  /// Asks the owner of `cancel.partition` once. \return success (not_found included),
+  /// timeout / unavailable when nobody answered, or the owner's error.
+  Status send_cancel(const DueCancel& cancel) const;
+  /// Keeps `cancel` due (replacing an older one of the same route and partition).
+  void keep_due(DueCancel cancel);
+  /// The background thread: sends the due cancels until the services close.
+  void send_due_cancels();
   /// Runs `call` until it returns something else than timeout/unavailable, or stopping, or
   /// `give_up` (when given) has passed.
   template <class T>
@@ -107,6 +137,12 @@ class TopologyServices {
   Client<msg::DelayRequest, msg::DelayReply> delay_client_;
   Client<msg::CancelRouteRequest, msg::StatusReply> cancel_client_;
   Client<msg::HoldingsRequest, msg::HoldingsReply> holdings_client_;
+
+  mutable std::mutex due_mutex_;
+  std::condition_variable due_wake_;
+  std::vector<DueCancel> due_;
+  std::atomic<bool> closing_{false};  ///< set once, by the destructor
+  std::thread due_sender_;  ///< runs send_due_cancels; joined before the clients go
 };
 
 }  // namespace drover::logical_agent

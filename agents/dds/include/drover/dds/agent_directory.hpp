@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drover/common/clock.hpp"
@@ -39,6 +40,12 @@ struct AgentRecord {
   friend bool operator==(const AgentRecord&, const AgentRecord&) = default;
 };
 
+/// The live agent of `kind` among `records` that owns `partition` (the first by order of
+/// `records`, which the directory sorts by id), or nullptr. Where each partition is found:
+/// every service call to a partition goes to the agent this names.
+const AgentRecord* live_owner_among(const std::vector<AgentRecord>& records, std::string_view kind,
+                                    std::string_view partition);
+
 struct AgentDirectoryOptions {
   /// Requested heartbeat deadline; must not be shorter than the agents' (see
   /// kHeartbeatDeadline).
@@ -61,6 +68,8 @@ class AgentDirectory {
   /// The agents alive now, sorted by id.
   std::vector<AgentRecord> live_agents() const;
   std::optional<AgentRecord> find(const std::string& id) const;
+  /// The live agent of `kind` that owns `partition` now (see live_owner_among), if any.
+  std::optional<AgentRecord> live_owner_of(std::string_view kind, std::string_view partition) const;
 
   /// Waits until `predicate` holds for the records (as agents() returns them), evaluated
   /// after every change. \return whether it holds.
