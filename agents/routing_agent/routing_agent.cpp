@@ -373,11 +373,18 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
       abort_all(shares);
       bool undone = true;
       for (auto* share : to_undo) undone = cancel_route_on(plan.agent, route_id, share->owner) && undone;
-      if (commit_failed->code != ErrorCode::not_found) {
-        RouteError error{*commit_failed, {}};
-        if (!undone) error.route = route_id;  // the client may still cancel what is left
+      if (!undone) {
+        // Part of the route may stay reserved under this id: the client is told a topology
+        // agent did not answer, so that it cancels the id in every partition and asks again
+        // under another (a retry under this id would leave those parts where its cancels,
+        // sent where the new route runs, never reach).
+        RouteError error{Error{ErrorCode::unavailable, commit_failed->message + "; the commit could not be undone "
+                                                           "everywhere (route " + std::to_string(route_id) + ")"},
+                         {}};
+        error.route = route_id;
         return unexpected(std::move(error));
       }
+      if (commit_failed->code != ErrorCode::not_found) return unexpected(RouteError{*commit_failed, {}});
       last_conflict = Error{ErrorCode::conflict, commit_failed->message + " (the hold expired)"};
       continue;
     }

@@ -158,6 +158,39 @@ TEST(OrderBook, WithdrawsAQueuedOrderAtOnceAndARunningOneWhenTheExecutorEndsIt) 
                                             "c:running:"}));
 }
 
+TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysValid) {
+  const auto world = h_crossing();
+  OrderBook book(nullptr, 2);
+  const auto add = [&](const char* name) {
+    auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}}, {}});
+    ASSERT_TRUE(order);
+    ASSERT_TRUE(book.add(*order, 10));
+  };
+  for (const char* name : {"a", "b", "c", "d"}) add(name);
+  ASSERT_EQ(book.start_next(20)->name, "a");
+  EXPECT_FALSE(book.advance(21));  // a finished
+  const Order* b = book.start_next(22);
+  ASSERT_EQ(b->name, "b");
+  // Withdrawn behind the running b: kept until the orders before it are gone.
+  ASSERT_TRUE(book.withdraw("d", "not needed", 23));
+  ASSERT_TRUE(book.withdraw("c", "not needed", 24));
+  // Three ended (a, c, d), two kept: a, the oldest, is forgotten, b's pointer still holds.
+  EXPECT_EQ(book.find("a"), nullptr);
+  EXPECT_EQ(book.current(), b);
+  EXPECT_EQ(b->name, "b");
+  ASSERT_NE(book.find("c"), nullptr);
+  // A forgotten name may come again; a kept one may not.
+  add("a");
+  auto again = make_order(*world, OrderSpec{"c", {{"left-4", "NOP", {}}}, {}});
+  ASSERT_TRUE(again);
+  EXPECT_EQ(book.add(*again, 30).error().code, ErrorCode::conflict);
+  EXPECT_FALSE(book.advance(31));  // b finished: b, c and d ended, b (the oldest) goes
+  EXPECT_EQ(book.find("b"), nullptr);
+  EXPECT_NE(book.find("c"), nullptr);
+  EXPECT_NE(book.find("d"), nullptr);
+  EXPECT_EQ(book.start_next(32)->name, "a");
+}
+
 TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_FALSE(operation_action(Destination{0, "x", "NOP", {}}));
   EXPECT_FALSE(operation_action(Destination{0, "x", "", {}}));

@@ -92,7 +92,7 @@ bool OrderBook::advance(TimeNs now) {
   if (order->destination >= order->destinations.size()) {
     order->state = OrderState::finished;
     order->finished = now;
-    publish(*order);
+    publish_ended(*order);
     return false;
   }
   publish(*order);
@@ -105,7 +105,7 @@ void OrderBook::fail_current(const std::string& reason, TimeNs now) {
   order->state = OrderState::failed;
   order->finished = now;
   order->failure = reason;
-  publish(*order);
+  publish_ended(*order);
 }
 
 Result<OrderState> OrderBook::withdraw(const std::string& name, const std::string& reason, TimeNs now) {
@@ -117,7 +117,7 @@ Result<OrderState> OrderBook::withdraw(const std::string& name, const std::strin
       order.state = OrderState::withdrawn;
       order.finished = now;
       order.failure = reason;
-      publish(order);
+      publish_ended(order);
       break;
     case OrderState::running:
       if (!order.withdrawal) order.withdrawal = reason;
@@ -143,7 +143,18 @@ void OrderBook::end_withdrawn(TimeNs now) {
   order->finished = now;
   order->failure = order->withdrawal.value_or("");
   order->withdrawal.reset();
-  publish(*order);
+  publish_ended(*order);
+}
+
+void OrderBook::publish_ended(const Order& order) {
+  publish(order);
+  ++ended_;
+  while (ended_ > ended_kept_ && !orders_.empty()) {
+    const OrderState state = orders_.front().state;
+    if (state == OrderState::queued || state == OrderState::running) break;  // older ended ones wait behind it
+    orders_.pop_front();
+    --ended_;
+  }
 }
 
 std::size_t OrderBook::queued_count() const {

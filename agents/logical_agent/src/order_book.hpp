@@ -71,7 +71,13 @@ class OrderBook {
  public:
   /// Called with the order after every change (queued, started, advanced, ended).
   using Observer = std::function<void(const Order&)>;
-  explicit OrderBook(Observer observer) : observer_(std::move(observer)) {}
+  /// How many ended orders are kept for lookups (name conflicts, late withdrawals) by default.
+  static constexpr std::size_t kEndedKept = 1000;
+  /// \param ended_kept  ended orders kept, the oldest forgotten first (an agent runs for
+  ///                    months: its book must not grow with every order it ever ran); a
+  ///                    forgotten order's name may be used again
+  explicit OrderBook(Observer observer, std::size_t ended_kept = kEndedKept)
+      : observer_(std::move(observer)), ended_kept_(ended_kept) {}
 
   /// Queues `order` at `now`. \return its 1-based position among the unfinished orders,
   ///         or conflict when an order of that name is known (nothing changes).
@@ -107,9 +113,14 @@ class OrderBook {
   void publish(const Order& order) const {
     if (observer_) observer_(order);
   }
+  /// Publishes `order`, which has just ended, then forgets the oldest ended orders beyond
+  /// ended_kept_. Only from the front: pointers to the others (current()) stay valid.
+  void publish_ended(const Order& order);
 
   Observer observer_;
-  std::deque<Order> orders_;  ///< in arrival order; ended ones stay for lookups
+  std::size_t ended_kept_;
+  std::size_t ended_ = 0;     ///< ended orders in orders_
+  std::deque<Order> orders_;  ///< in arrival order; ended ones stay for lookups (see ended_kept_)
 };
 
 }  // namespace drover::logical_agent

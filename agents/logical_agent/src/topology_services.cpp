@@ -1,8 +1,10 @@
 #include "agents/logical_agent/src/topology_services.hpp"
 
 #include <algorithm>
+#include <deque>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -204,24 +206,31 @@ Status TopologyServices::send_cancel(const DueCancel& cancel) const {
 
 void TopologyServices::keep_due(DueCancel cancel) {
   std::lock_guard lock(due_mutex_);
+  add_due_locked(std::move(cancel), true);
+  due_wake_.notify_all();
+}
+
+void TopologyServices::add_due_locked(DueCancel cancel, bool replace) {
   const auto same = std::find_if(due_.begin(), due_.end(), [&](const DueCancel& due) {
     return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
   });
   if (same != due_.end()) {
-    *same = std::move(cancel);
-  } else if (due_.size() >= kMostCancelsDue) {
-    spdlog::error("{} route cancels are due; route {} is not cancelled in partition '{}' (its topology agent keeps "
-                  "it until this agent is gone)",
-                  due_.size(), cancel.route, cancel.partition);
-  } else {
-    due_.push_back(std::move(cancel));
+    if (replace) *same = std::move(cancel);
+    return;
   }
-  due_wake_.notify_all();
+  if (due_.size() >= kMostCancelsDue) {
+    const DueCancel& oldest = due_.front();
+    spdlog::error("{} route cancels are due: route {} is given up in partition '{}' (its topology agent keeps it "
+                  "until this agent is gone)",
+                  due_.size(), oldest.route, oldest.partition);
+    due_.pop_front();
+  }
+  due_.push_back(std::move(cancel));
 }
 
 std::size_t TopologyServices::cancels_due() const {
   std::lock_guard lock(due_mutex_);
-  return due_.size();
+  return due_.size() + in_flight_;
 }
 
 void TopologyServices::send_due_cancels() {
@@ -229,17 +238,21 @@ void TopologyServices::send_due_cancels() {
   while (!closing_) {
     due_wake_.wait_for(lock, kDueCancelPause, [&] { return closing_.load(); });
     // Calls go out unlocked: cancel_route may add to the list meanwhile.
-    std::vector<DueCancel> due = std::move(due_);
-    due_.clear();
+    std::deque<DueCancel> due = std::exchange(due_, {});
+    in_flight_ = due.size();
     lock.unlock();
     std::vector<DueCancel> still_due;
+    std::set<std::string> silent;  // partitions whose owner did not answer this round
     for (auto& cancel : due) {
-      // Not sent while the agent stops: a call may take call_timeout, and the destructor waits.
-      if (stopping_ || closing_ || !directory_->live_owner_of("topology", cancel.partition)) {
+      // Not sent while the agent stops: a call may take call_timeout, and the destructor
+      // waits. Nor to an owner silent this round: each call would wait as long.
+      if (stopping_ || closing_ || silent.contains(cancel.partition) ||
+          !directory_->live_owner_of("topology", cancel.partition)) {
         still_due.push_back(std::move(cancel));
         continue;
       }
       if (auto sent = send_cancel(cancel); !sent && nobody_answered(sent.error())) {
+        silent.insert(cancel.partition);
         still_due.push_back(std::move(cancel));
       } else if (!sent) {
         spdlog::warn("route {} not cancelled in partition '{}': {}", cancel.route, cancel.partition,
@@ -249,13 +262,9 @@ void TopologyServices::send_due_cancels() {
       }
     }
     lock.lock();
-    // Newer cancels of the same route and partition, added meanwhile, stand.
-    for (auto& cancel : still_due) {
-      const bool newer = std::any_of(due_.begin(), due_.end(), [&](const DueCancel& due) {
-        return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
-      });
-      if (!newer) due_.push_back(std::move(cancel));
-    }
+    in_flight_ = 0;
+    // Cancels of the same route and partition added meanwhile are newer: they stand.
+    for (auto& cancel : still_due) add_due_locked(std::move(cancel), false);
   }
   for (const auto& cancel : due_) {
     spdlog::warn("route {} left reserved in partition '{}': its owner never answered the cancel (it goes once the "

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -119,6 +120,9 @@ class TopologyServices {
   Status send_cancel(const DueCancel& cancel) const;
   /// Keeps `cancel` due (replacing an older one of the same route and partition).
   void keep_due(DueCancel cancel);
+  /// Adds `cancel` to due_ (due_mutex_ held): one of the same route and partition there is
+  /// replaced when `replace`, else kept instead; past the bound the oldest is given up.
+  void add_due_locked(DueCancel cancel, bool replace);
   /// The background thread: sends the due cancels until the services close.
   void send_due_cancels();
   /// Runs `call` until it returns something else than timeout/unavailable, or stopping, or
@@ -140,7 +144,8 @@ class TopologyServices {
 
   mutable std::mutex due_mutex_;
   std::condition_variable due_wake_;
-  std::vector<DueCancel> due_;
+  std::deque<DueCancel> due_;  ///< oldest first
+  std::size_t in_flight_ = 0;  ///< taken from due_ by the round under way (cancels_due counts them)
   std::atomic<bool> closing_{false};  ///< set once, by the destructor
   std::thread due_sender_;  ///< runs send_due_cancels; joined before the clients go
 };
