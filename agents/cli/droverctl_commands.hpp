@@ -24,6 +24,9 @@ void add_order_command(CLI::App& app, CommandContext& context);
 void add_lock_command(CLI::App& app, CommandContext& context);
 void add_unlock_command(CLI::App& app, CommandContext& context);
 void add_timeline_command(CLI::App& app, CommandContext& context);
+/// `droverctl release ENTITY --from AGENT`: gives up an allocation a logical agent that is
+/// gone left behind.
+void add_release_command(CLI::App& app, CommandContext& context);
 
 /// `droverctl vehicles`: what every vehicle is doing, from its logical agent's state;
 /// `droverctl alarms`: follows the operator alarms as they are raised.

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   add_agents_command(app, context);
   add_lock_command(app, context);
   add_unlock_command(app, context);
+  add_release_command(app, context);
   add_timeline_command(app, context);
   add_order_command(app, context);
   add_vehicles_command(app, context);

@@ -186,8 +186,9 @@ void TopologyAgent::sweep_departed(const std::string& agent, const std::string& 
     // Its vehicle stands (or stood) there, driven by nobody: an operator must see to it.
     alarm.severity(msg::ALARM_ERROR);
     alarm.text(fmt::format("logical agent '{}' is gone ({}): its vehicle keeps '{}' allocated in {} until its agent "
-                           "comes back; the rest of its {} route(s) there is cancelled",
-                           agent, why, fmt::join(kept, "', '"), where, routes));
+                           "comes back or an operator releases them (droverctl release ENTITY --from {}); the rest "
+                           "of its {} route(s) there is cancelled",
+                           agent, why, fmt::join(kept, "', '"), where, agent, routes));
   }
   spdlog::log(kept.empty() ? spdlog::level::warn : spdlog::level::err, "alarm: {}", alarm.text());
   if (auto written = alarm_writer_->write(alarm); !written) {

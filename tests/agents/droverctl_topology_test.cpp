@@ -196,6 +196,12 @@ TEST_F(DroverctlTopologyTest, BadInputIsExit2AndNoAgentIsExit3) {
                        "--timeout", "1"},
                       out, err),
             3);
+  EXPECT_EQ(droverctl({"release", "a", "--domain", domain}, out, err), 2) << "--from is required";
+  EXPECT_EQ(droverctl({"release", "nowhere", "--from", "v1", "--domain", domain, "--timeout", "3"}, out, err), 2);
+  EXPECT_NE(err.find("unknown entity 'nowhere'"), std::string::npos) << err;
+  EXPECT_EQ(droverctl({"release", "a", "--from", "v1", "--domain", domain}, out, err), 1);
+  EXPECT_NE(err.find("'v1' does not hold 'a'"), std::string::npos) << err;
+  EXPECT_EQ(droverctl({"release", "a", "--from", "v1", "--domain", "63", "--timeout", "1"}, out, err), 3);
   EXPECT_EQ(droverctl({"timeline", "--help"}, out, err), 0);
   EXPECT_NE(out.find("--domain"), std::string::npos);
 }

@@ -470,6 +470,18 @@ class FleetTest : public ::testing::Test {
   std::unique_ptr<dds::ServiceClient<msg::OrderRequest, msg::OrderReply>> order_client_;
 };
 
+/// Runs droverctl to its end. \return its exit code (-1 if it did not end); output in out/err.
+int droverctl(const Fleet& fleet, const std::string& name, const std::vector<std::string>& args, std::string& out,
+              std::string& err) {
+  const std::string stem = (fleet.dir() / ("droverctl-" + name)).string();
+  auto child = ChildProcess::spawn(binary_path("droverctl"), args, stem + ".out", stem + ".err");
+  if (!child) return -1;
+  auto status = child->wait_exit(kRunTimeout);
+  out = read_file(stem + ".out");
+  err = read_file(stem + ".err");
+  return status && status->exited ? status->code : -1;
+}
+
 TEST_F(FleetTest, CrossingVehiclesBothFinishAndTheLaterWaitsForTheEarlier) {
   constexpr std::uint32_t kDomain = 86;
   Fleet fleet(kDomain, "crossing");
@@ -727,7 +739,7 @@ TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNo
   }
 }
 
-TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesAndTheOperatorIsTold) {
+TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesTillTheToldOperatorReleasesIt) {
   constexpr std::uint32_t kDomain = 46;
   Fleet fleet(kDomain, "logical-gone");
   ASSERT_NO_FATAL_FAILURE(start_v1_towards_the_station(fleet, kDomain));
@@ -740,17 +752,36 @@ TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOcc
   ASSERT_TRUE(station.has_value()) << "V2's order did not end";
   EXPECT_EQ(station->state(), msg::ORDER_FINISHED) << station->failure();
 
+  {
+    std::lock_guard lock(seen_.mutex);
+    // The vehicle stopped on left-2, where its last move took it: that stays allocated, and
+    // the operator is told so by the topology agent.
+    EXPECT_EQ(seen_.holders["left-2"], "V1");
+    const auto gone = std::find_if(seen_.alarms.begin(), seen_.alarms.end(), [](const msg::OperatorAlarm& alarm) {
+      return alarm.agent() == "topology" && alarm.vehicle() == "V1" && alarm.severity() == msg::ALARM_ERROR &&
+             alarm.text().find("is gone") != std::string::npos && alarm.text().find("'left-2'") != std::string::npos;
+    });
+    EXPECT_NE(gone, seen_.alarms.end()) << "no alarm of the topology agent about V1";
+    EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+    EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  }
+
+  // The operator clears what V1 left (its vehicle towed away), with droverctl; V2, alive,
+  // keeps what it holds.
+  const std::string domain = std::to_string(kDomain);
+  std::string out, err;
+  EXPECT_EQ(droverctl(fleet, "release-live", {"release", "right-4", "--from", "V2", "--domain", domain}, out, err), 1)
+      << out << err;
+  EXPECT_NE(err.find("'V2' is alive"), std::string::npos) << err;
+  EXPECT_EQ(droverctl(fleet, "release", {"release", "left-2", "--from", "V1", "--domain", domain}, out, err), 0)
+      << out << err;
+  EXPECT_NE(out.find("released left-2 from V1"), std::string::npos) << out;
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders["left-2"].empty(); }, 30s)) << "left-2 is still V1's";
+  EXPECT_EQ(droverctl(fleet, "release-again", {"release", "left-2", "--from", "V1", "--domain", domain}, out, err), 1)
+      << out << err;
+  EXPECT_NE(err.find("'V1' does not hold 'left-2'"), std::string::npos) << err;
   std::lock_guard lock(seen_.mutex);
-  // The vehicle stopped on left-2, where its last move took it: that stays allocated, and
-  // the operator is told so by the topology agent.
-  EXPECT_EQ(seen_.holders["left-2"], "V1");
-  const auto gone = std::find_if(seen_.alarms.begin(), seen_.alarms.end(), [](const msg::OperatorAlarm& alarm) {
-    return alarm.agent() == "topology" && alarm.vehicle() == "V1" && alarm.severity() == msg::ALARM_ERROR &&
-           alarm.text().find("is gone") != std::string::npos && alarm.text().find("'left-2'") != std::string::npos;
-  });
-  EXPECT_NE(gone, seen_.alarms.end()) << "no alarm of the topology agent about V1";
-  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
-  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+  EXPECT_EQ(seen_.holders["right-4"], "V2");
 }
 
 TEST_F(FleetTest, ATopologyAgentRestartedFromItsJournalSweepsALogicalAgentThatWentAwayWhileItWasDown) {
@@ -933,18 +964,6 @@ TEST_F(FleetTest, StoppedLogicalAgentStopsItsVehicleAndCancelsItsRouteAhead) {
   std::lock_guard lock(seen_.mutex);
   EXPECT_LT(seen_.latest["V1"].pose.y, 6.0) << "V1 drove on after its agent stopped";
   for (const auto* ahead : {"bar-2", "right-4"}) EXPECT_NE(seen_.holders[ahead], "V1") << ahead;
-}
-
-/// Runs droverctl to its end. \return its exit code (-1 if it did not end); output in out/err.
-int droverctl(const Fleet& fleet, const std::string& name, const std::vector<std::string>& args, std::string& out,
-              std::string& err) {
-  const std::string stem = (fleet.dir() / ("droverctl-" + name)).string();
-  auto child = ChildProcess::spawn(binary_path("droverctl"), args, stem + ".out", stem + ".err");
-  if (!child) return -1;
-  auto status = child->wait_exit(kRunTimeout);
-  out = read_file(stem + ".out");
-  err = read_file(stem + ".err");
-  return status && status->exited ? status->code : -1;
 }
 
 TEST_F(FleetTest, WithdrawnOrdersEndAQueuedOneAtOnceARunningOneOnAVertexAndTheVehicleWorksOn) {
