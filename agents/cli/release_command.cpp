@@ -4,6 +4,7 @@
 // AGENT is alive: a running logical agent releases what it holds itself, once its vehicle
 // has left it, and only it knows where the vehicle is.
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -107,7 +108,11 @@ int run_release(const ReleaseArguments& arguments) {
   int exit_code = kExitOk;
   request.shadows_only(true);
   for (const auto& agent : (*directory)->live_agents()) {
-    if (agent.kind != "topology" || agent.id == owner->id) continue;
+    // Another agent serving the owner's partitions (a standby) has no shadows of its own to drop.
+    const bool shares_partition = std::any_of(agent.owns.begin(), agent.owns.end(), [&](const std::string& p) {
+      return std::find(owner->owns.begin(), owner->owns.end(), p) != owner->owns.end();
+    });
+    if (agent.kind != "topology" || agent.id == owner->id || shares_partition) continue;
     auto shadows = (*client)->call(request, arguments.dds.timeout(), agent.id);
     const std::string problem = !shadows ? shadows.error().message
                                 : shadows->error().code() != msg::ERROR_NONE ? shadows->error().message()

@@ -191,6 +191,19 @@ TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysVali
   EXPECT_EQ(book.start_next(32)->name, "a");
 }
 
+TEST(OrderBook, AWithdrawnOrderForgottenAtOnceStillAnswersWithdrawn) {
+  const auto world = h_crossing();
+  OrderBook book(nullptr, 0);  // keeps no ended order: the withdrawn one goes as it ends
+  for (const char* name : {"a", "b"}) {
+    auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}}, {}});
+    ASSERT_TRUE(order);
+    ASSERT_TRUE(book.add(*order, 10));
+  }
+  EXPECT_EQ(book.withdraw("a", "not needed", 20).value(), OrderState::withdrawn);
+  EXPECT_EQ(book.find("a"), nullptr);
+  EXPECT_EQ(book.start_next(30)->name, "b");
+}
+
 TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_FALSE(operation_action(Destination{0, "x", "NOP", {}}));
   EXPECT_FALSE(operation_action(Destination{0, "x", "", {}}));

@@ -117,8 +117,8 @@ Result<OrderState> OrderBook::withdraw(const std::string& name, const std::strin
       order.state = OrderState::withdrawn;
       order.finished = now;
       order.failure = reason;
-      publish_ended(order);
-      break;
+      publish_ended(order);  // may forget it: `order` is not read again
+      return OrderState::withdrawn;
     case OrderState::running:
       if (!order.withdrawal) order.withdrawal = reason;
       break;

@@ -114,7 +114,8 @@ class OrderBook {
     if (observer_) observer_(order);
   }
   /// Publishes `order`, which has just ended, then forgets the oldest ended orders beyond
-  /// ended_kept_. Only from the front: pointers to the others (current()) stay valid.
+  /// ended_kept_, `order` itself possibly (not to be read afterwards). Only from the front:
+  /// pointers to the others (current()) stay valid.
   void publish_ended(const Order& order);
 
   Observer observer_;

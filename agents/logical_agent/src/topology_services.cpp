@@ -206,16 +206,16 @@ Status TopologyServices::send_cancel(const DueCancel& cancel) const {
 
 void TopologyServices::keep_due(DueCancel cancel) {
   std::lock_guard lock(due_mutex_);
-  add_due_locked(std::move(cancel), true);
+  add_due_locked(std::move(cancel));
   due_wake_.notify_all();
 }
 
-void TopologyServices::add_due_locked(DueCancel cancel, bool replace) {
+void TopologyServices::add_due_locked(DueCancel cancel) {
   const auto same = std::find_if(due_.begin(), due_.end(), [&](const DueCancel& due) {
     return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
   });
   if (same != due_.end()) {
-    if (replace) *same = std::move(cancel);
+    *same = std::move(cancel);
     return;
   }
   if (due_.size() >= kMostCancelsDue) {
@@ -263,8 +263,16 @@ void TopologyServices::send_due_cancels() {
     }
     lock.lock();
     in_flight_ = 0;
-    // Cancels of the same route and partition added meanwhile are newer: they stand.
-    for (auto& cancel : still_due) add_due_locked(std::move(cancel), false);
+    // Back in front, oldest first, of those added meanwhile, which are newer: one of the
+    // same route and partition among them stands instead.
+    std::deque<DueCancel> added = std::exchange(due_, {});
+    for (auto& cancel : still_due) {
+      const bool replaced = std::any_of(added.begin(), added.end(), [&](const DueCancel& newer) {
+        return newer.route == cancel.route && newer.partition == cancel.partition && newer.agent == cancel.agent;
+      });
+      if (!replaced) due_.push_back(std::move(cancel));
+    }
+    for (auto& cancel : added) add_due_locked(std::move(cancel));
   }
   for (const auto& cancel : due_) {
     spdlog::warn("route {} left reserved in partition '{}': its owner never answered the cancel (it goes once the "

@@ -120,9 +120,9 @@ class TopologyServices {
   Status send_cancel(const DueCancel& cancel) const;
   /// Keeps `cancel` due (replacing an older one of the same route and partition).
   void keep_due(DueCancel cancel);
-  /// Adds `cancel` to due_ (due_mutex_ held): one of the same route and partition there is
-  /// replaced when `replace`, else kept instead; past the bound the oldest is given up.
-  void add_due_locked(DueCancel cancel, bool replace);
+  /// Adds `cancel` to due_ (due_mutex_ held), replacing one of the same route and
+  /// partition; past the bound the oldest is given up.
+  void add_due_locked(DueCancel cancel);
   /// The background thread: sends the due cancels until the services close.
   void send_due_cancels();
   /// Runs `call` until it returns something else than timeout/unavailable, or stopping, or
