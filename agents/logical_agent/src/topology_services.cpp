@@ -211,9 +211,8 @@ void TopologyServices::keep_due(DueCancel cancel) {
 }
 
 void TopologyServices::add_due_locked(DueCancel cancel) {
-  const auto same = std::find_if(due_.begin(), due_.end(), [&](const DueCancel& due) {
-    return due.route == cancel.route && due.partition == cancel.partition && due.agent == cancel.agent;
-  });
+  const auto same =
+      std::find_if(due_.begin(), due_.end(), [&](const DueCancel& due) { return due.same_target(cancel); });
   if (same != due_.end()) {
     *same = std::move(cancel);
     return;
@@ -267,9 +266,8 @@ void TopologyServices::send_due_cancels() {
     // same route and partition among them stands instead.
     std::deque<DueCancel> added = std::exchange(due_, {});
     for (auto& cancel : still_due) {
-      const bool replaced = std::any_of(added.begin(), added.end(), [&](const DueCancel& newer) {
-        return newer.route == cancel.route && newer.partition == cancel.partition && newer.agent == cancel.agent;
-      });
+      const bool replaced =
+          std::any_of(added.begin(), added.end(), [&](const DueCancel& newer) { return newer.same_target(cancel); });
       if (!replaced) due_.push_back(std::move(cancel));
     }
     for (auto& cancel : added) add_due_locked(std::move(cancel));

@@ -110,6 +110,10 @@ class TopologyServices {
     topology::RouteId route = 0;
     std::vector<std::uint32_t> held_steps;
     std::string partition;
+    /// Whether `other` cancels the same route in the same partition (the later one stands).
+    bool same_target(const DueCancel& other) const {
+      return route == other.route && partition == other.partition && agent == other.agent;
+    }
   };
 
   TopologyServices(std::shared_ptr<const topology::Topology> topology, std::chrono::milliseconds call_timeout,
