@@ -71,15 +71,9 @@ int run_lock(const LockArguments& arguments) {
   request.window().end(*until);
   request.operator_id(arguments.operator_id.empty() ? (*participant)->agent_id() : arguments.operator_id);
   request.reason(arguments.reason);
-  auto reply = (*client)->call(request, arguments.dds.timeout(), owner->id);
-  if (!reply) {
-    std::cerr << "error: topology agent '" << owner->id << "': " << reply.error().message << "\n";
-    return kExitNoAnswer;
-  }
-  if (reply->error().code() != msg::ERROR_NONE) {
-    std::cerr << "error: topology agent '" << owner->id << "' refused: " << reply->error().message() << "\n";
-    return kExitFailure;
-  }
+  int exit_code = kExitOk;
+  const auto reply = call_topology_agent(**client, request, arguments.dds.timeout(), owner->id, exit_code);
+  if (!reply) return exit_code;
   std::cout << reply->lock_id() << "\n";
   for (const auto& hit : reply->hit()) {
     std::cout << "hit: " << hit.agent() << " route " << hit.route() << " step " << hit.step() << " on "

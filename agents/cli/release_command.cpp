@@ -94,18 +94,10 @@ int run_release(const ReleaseArguments& arguments) {
   request.entity(arguments.entity);
   request.route(held->route());
   request.step(held->step());
-  auto reply = (*client)->call(request, arguments.dds.timeout(), owner->id);
-  if (!reply) {
-    std::cerr << "error: topology agent '" << owner->id << "': " << reply.error().message << "\n";
-    return kExitNoAnswer;
-  }
-  if (reply->error().code() != msg::ERROR_NONE) {
-    std::cerr << "error: topology agent '" << owner->id << "' refused: " << reply->error().message() << "\n";
-    return kExitFailure;
-  }
+  int exit_code = kExitOk;
+  if (!call_topology_agent(**client, request, arguments.dds.timeout(), owner->id, exit_code)) return exit_code;
   // The step's shadows on entities other partitions own go there (each agent drops those it
   // has; an agent without any answers as much).
-  int exit_code = kExitOk;
   request.shadows_only(true);
   for (const auto& agent : (*directory)->live_agents()) {
     // Another agent serving the owner's partitions (a standby) has no shadows of its own to drop.

@@ -1,14 +1,20 @@
 #pragma once
-// What droverctl's topology commands (lock, unlock, timeline) share: shared-clock times
-// given on the command line, and finding the topology agent that owns an entity.
+// What droverctl's topology commands (lock, unlock, timeline, release) share: shared-clock
+// times given on the command line, finding the topology agent that owns an entity, and
+// calling it.
 
 #include <chrono>
+#include <iostream>
+#include <optional>
 #include <string>
 
 #include "drover/common/clock.hpp"
 #include "drover/common/result.hpp"
 #include "drover/dds/agent_directory.hpp"
 #include "drover/dds/participant.hpp"
+#include "drover/dds/service_client.hpp"
+#include "agents/cli/command.hpp"
+#include "common.h"
 
 namespace drover::cli {
 
@@ -31,5 +37,25 @@ Result<dds::AgentRecord> any_topology_agent(dds::Participant& participant, std::
 /// The exit code of a failure to reach the agents: kExitNoAnswer for unavailable or timeout,
 /// kExitBadInput for not_found or invalid_argument, kExitFailure otherwise.
 int exit_code_of(const Error& error);
+
+/// Calls topology agent `agent` with `request`. \return its reply when it answered without
+/// error; otherwise nullopt, with "error: topology agent 'ID': ..." printed and `exit_code`
+/// set: kExitNoAnswer when it did not answer, kExitFailure when it refused.
+template <class Req, class Rep>
+std::optional<Rep> call_topology_agent(dds::ServiceClient<Req, Rep>& client, const Req& request,
+                                       std::chrono::milliseconds timeout, const std::string& agent, int& exit_code) {
+  auto reply = client.call(request, timeout, agent);
+  if (!reply) {
+    std::cerr << "error: topology agent '" << agent << "': " << reply.error().message << "\n";
+    exit_code = kExitNoAnswer;
+    return std::nullopt;
+  }
+  if (reply->error().code() != msg::ERROR_NONE) {
+    std::cerr << "error: topology agent '" << agent << "' refused: " << reply->error().message() << "\n";
+    exit_code = kExitFailure;
+    return std::nullopt;
+  }
+  return std::move(*reply);
+}
 
 }  // namespace drover::cli
