@@ -108,13 +108,8 @@ void LogicalAgent::run() {
   // reservations go; what the vehicle occupies stays allocated.
   stop_vehicle();
   if (route_) {
-    if (auto cancelled = services_->cancel_route(vehicle_id(), route_->id(), monitor_.held_steps_of(route_->id()),
-                                                 services_->partitions_touched(route_->steps()));
-        !cancelled) {
-      spdlog::warn("route {} not cancelled on shutdown: {}", route_->id(), cancelled.error().message);
-    } else {
-      spdlog::info("route {} cancelled on shutdown", route_->id());
-    }
+    spdlog::info("cancelling route {} on shutdown", route_->id());
+    cancel_route_quietly(*route_);
   }
 }
 
