@@ -204,6 +204,76 @@ TEST(OrderBook, AWithdrawnOrderForgottenAtOnceStillAnswersWithdrawn) {
   EXPECT_EQ(book.start_next(30)->name, "b");
 }
 
+TEST(OrderBook, RecordsEveryChangeBeforePublishingAndARecordingFailureRefusesANewOrder) {
+  const auto world = h_crossing();
+  std::vector<std::string> events;
+  bool disk_full = false;
+  OrderBook book([&](const Order& order) { events.push_back("published " + order.name + ":" + to_string(order.state)); },
+                 OrderBook::kEndedKept, [&](const Order& order, bool added) -> Status {
+                   if (disk_full) return fail(ErrorCode::io, "disk full");
+                   events.push_back(std::string(added ? "added " : "recorded ") + order.name + ":" +
+                                    to_string(order.state) + ":" + std::to_string(order.destination) + ":" +
+                                    order.action_command.value_or("-") + ":" + order.withdrawal.value_or("-"));
+                   return {};
+                 });
+  auto a = make_order(*world, OrderSpec{"a", {{"left-4", "load", {}}, {"right-4", "unload", {}}}, {}});
+  auto b = make_order(*world, OrderSpec{"b", {{"left-0", "NOP", {}}}, {}});
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(book.add(*a, 10));
+  ASSERT_EQ(book.start_next(20)->name, "a");
+  book.action_commanded("c-1");
+  EXPECT_TRUE(book.advance(30));  // the next destination has no action commanded yet
+  ASSERT_TRUE(book.withdraw("a", "line stopped", 40));
+
+  disk_full = true;
+  const auto refused = book.add(*b, 50);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::io);
+  EXPECT_EQ(book.find("b"), nullptr) << "a refused order is not queued";
+  EXPECT_EQ(book.queued_count(), 0u);
+  book.end_withdrawn(60);  // other changes go on, published though not recorded
+  EXPECT_EQ(book.find("a")->state, OrderState::withdrawn);
+
+  EXPECT_EQ(events, (std::vector<std::string>{
+                        "added a:queued:0:-:-", "published a:queued", "recorded a:running:0:-:-", "published a:running",
+                        "recorded a:running:0:c-1:-", "recorded a:running:1:-:-", "published a:running",
+                        "recorded a:running:1:-:line stopped", "published a:withdrawn"}));
+}
+
+TEST(OrderBook, RestoresWhatAnEarlierLifeStoredAndGoesOnFromThere) {
+  const auto world = h_crossing();
+  std::vector<std::string> published;
+  std::size_t recorded = 0;
+  OrderBook book([&](const Order& order) { published.push_back(order.name + ":" + to_string(order.state)); }, 1,
+                 [&](const Order&, bool) -> Status {
+                   ++recorded;
+                   return {};
+                 });
+  std::vector<Order> stored;
+  for (const char* name : {"old", "older-still", "running", "queued"}) {
+    auto order = make_order(*world, OrderSpec{name, {{"left-4", "load", {}}, {"right-4", "NOP", {}}}, {}});
+    ASSERT_TRUE(order);
+    stored.push_back(*order);
+  }
+  stored[0].state = OrderState::finished;
+  stored[1].state = OrderState::failed;
+  stored[2].state = OrderState::running;
+  stored[2].destination = 1;
+  book.restore(stored);
+  EXPECT_EQ(recorded, 0u) << "restored orders are stored already";
+  EXPECT_EQ(published, (std::vector<std::string>{"old:finished", "older-still:failed", "running:running", "queued:queued"}));
+  // One ended order kept: the oldest goes; names known stay refused.
+  EXPECT_EQ(book.find("old"), nullptr);
+  ASSERT_NE(book.find("older-still"), nullptr);
+  EXPECT_EQ(book.add(stored[3], 5).error().code, ErrorCode::conflict);
+  // The running order goes on where it was, then the queue.
+  ASSERT_NE(book.current(), nullptr);
+  EXPECT_EQ(book.start_next(10)->name, "running");
+  EXPECT_EQ(book.current()->destination, 1u);
+  EXPECT_FALSE(book.advance(20));
+  EXPECT_EQ(book.start_next(30)->name, "queued");
+}
+
 TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_FALSE(operation_action(Destination{0, "x", "NOP", {}}));
   EXPECT_FALSE(operation_action(Destination{0, "x", "", {}}));

@@ -118,6 +118,7 @@ const std::vector<KindRules>& kind_rules() {
         {"error_limit", "--error-limit", FieldType::positive_number},
         {"route_limit", "--route-limit", FieldType::number},
         {"wait_alarm", "--wait-alarm", FieldType::number},
+        {"db", "--db", FieldType::journal},
         {"log_level", "--log-level", FieldType::text}}},
       {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
        {{"seed", "--seed", FieldType::count, 0, kLargestWhole},
@@ -539,7 +540,12 @@ class LaunchFileParser {
         }
         std::filesystem::path journal = value.get<std::string>();
         if (journal.is_relative()) journal = state_dir_ / journal;
-        options.insert(options.end(), {option, journal.lexically_normal().string()});
+        const std::string file = journal.lexically_normal().string();
+        // A second agent on a journal would be refused at its start (the file is locked).
+        if (auto [other, inserted] = journal_users_.emplace(file, where); !inserted) {
+          return checker_.problem(where, "journal " + file + " is " + other->second + "'s too (one journal per agent)");
+        }
+        options.insert(options.end(), {option, file});
         return;
       }
     }
@@ -624,6 +630,7 @@ class LaunchFileParser {
     Json logical;                          ///< for the logical agent's --vehicle file
   };
   std::map<std::string, Profile> profiles_;
+  std::map<std::string, std::string> journal_users_;  ///< journal file -> the field naming it first
   // Per agent entry, parallel to file_.agents: its start vertex, its place, its partition.
   std::vector<std::string> starts_;
   std::vector<std::string> wheres_;

@@ -1,6 +1,7 @@
 // `drover logical-agent --id V1 --topology FILE [options]`: the logical agent of one vehicle
 // (docs/logical-agent.md) until SIGINT or SIGTERM (exit 0; its future reservations are
-// cancelled). Bad options or files: exit 2; DDS setup failures: exit 1.
+// cancelled). Bad options or files (an order journal damaged or another vehicle's
+// included): exit 2; DDS setup failures, an order journal that cannot be opened: exit 1.
 
 #include <iostream>
 #include <memory>
@@ -26,6 +27,7 @@ struct LogicalAgentArguments {
   std::string ran_agent;
   std::uint32_t domain_id = 0;
   std::string xml_profile;
+  std::string order_journal;
   ClockArguments clock;
   std::string log_level = "info";
   std::size_t lookahead = 2;
@@ -71,6 +73,7 @@ int run(const LogicalAgentArguments& arguments) {
   options.error_limit = seconds_to_ns(arguments.error_limit);
   options.route_limit = seconds_to_ns(arguments.route_limit);
   options.wait_alarm = seconds_to_ns(arguments.wait_alarm);
+  options.order_journal = arguments.order_journal;
 
   auto clock = make_clock(arguments.clock);
   if (!clock) return fail_input(clock.error().message);
@@ -82,7 +85,10 @@ int run(const LogicalAgentArguments& arguments) {
   auto agent = logical_agent::LogicalAgent::create(world, *clock, options);
   if (!agent) {
     std::cerr << "error: " << agent.error().message << "\n";
-    return agent.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
+    const ErrorCode code = agent.error().code;
+    const bool bad_input =
+        code == ErrorCode::invalid_argument || code == ErrorCode::parse || code == ErrorCode::conflict;
+    return bad_input ? kExitBadInput : kExitFailure;
   }
   spdlog::info("logical agent of vehicle '{}' on '{}', domain {}, time factor {}", arguments.vehicle_id,
                world->name(), arguments.domain_id, clock->factor());
@@ -112,6 +118,8 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
   command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
+  command->add_option("--db", arguments->order_journal,
+                      "Order journal (SQLite; created if absent): orders survive a restart of the agent");
   add_clock_options(*command, arguments->clock);
   command->add_option("--lookahead", arguments->lookahead, "Vertices allocated ahead of the vehicle (default 2)")
       ->transform(cli::whole_in(1, 1000));

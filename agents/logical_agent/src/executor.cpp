@@ -780,15 +780,24 @@ void LogicalAgent::abandon_route() {
   route_.reset();
 }
 
-Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activity) {
+Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activity, bool for_order) {
   set_activity(activity);
   ran::ActionCommand action = requested;
   action.id = next_command_id();
+  if (for_order) {
+    // Recorded before it is sent: an agent restarted after the RAN got it must not do it again.
+    std::lock_guard lock(mutex_);
+    book_.action_commanded(action.id);
+  }
   auto verdict = ran_->action(action, options_.call_timeout);
   if (!verdict) return fail(verdict.error().code, "the RAN did not take action '" + action.name + "': " + verdict.error().message);
   if (verdict->rejected()) {
     return fail(ErrorCode::not_permitted, "the RAN rejected action '" + action.name + "': " + verdict->code + " " + verdict->reason);
   }
+  return await_action(action.id, action.name);
+}
+
+Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name) {
   for (;;) {
     if (!wait_event()) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     bool replan = false;
@@ -796,20 +805,20 @@ Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activ
     std::optional<ran::CommandProgress> ended;
     {
       std::lock_guard lock(mutex_);
-      if (auto found = ended_commands_.find(action.id); found != ended_commands_.end()) {
+      if (auto found = ended_commands_.find(command); found != ended_commands_.end()) {
         ended = found->second;
         ended_commands_.erase(found);
       }
     }
     if (ended) {
       if (ended->state == ran::CommandState::finished) return {};
-      return fail(ErrorCode::unavailable, "action '" + action.name + "' " + ran::to_string(ended->state) + ": " +
+      return fail(ErrorCode::unavailable, "action '" + name + "' " + ran::to_string(ended->state) + ": " +
                                               ended->code + " " + ended->reason);
     }
     if (const auto status = latest_status()) {
       if (auto error = check_errors(*status)) {
-        if (auto cancelled = ran_->cancel(action.id, options_.call_timeout); !cancelled) {
-          spdlog::warn("cancel of action '{}' not delivered: {}", action.name, cancelled.error().message);
+        if (auto cancelled = ran_->cancel(command, options_.call_timeout); !cancelled) {
+          spdlog::warn("cancel of action '{}' not delivered: {}", name, cancelled.error().message);
         }
         return fail(ErrorCode::unavailable, *error);
       }
@@ -838,6 +847,7 @@ void LogicalAgent::execute_order() {
     Destination destination;
     std::string name;
     bool last = false;
+    std::optional<ran::CommandId> commanded;  // by an earlier life: the order was restored
     {
       std::lock_guard lock(mutex_);
       const Order* order = book_.current();
@@ -845,15 +855,21 @@ void LogicalAgent::execute_order() {
       destination = order->destinations[order->destination];
       name = order->name;
       last = order->destination + 1 == order->destinations.size();
+      commanded = order->action_command;
     }
-    if (end_if_withdrawn(name)) return;
-    Status done = drive_to(destination.location, Activity::driving, options_.route_limit);
-    if (end_if_withdrawn(name)) return;
-    if (done) {
-      if (auto action = operation_action(destination)) {
-        const bool charge = action->kind == ran::ActionKind::charge;
-        if (charge && !action->parameters.count("target")) action->parameters["target"] = std::to_string(options_.charge_to);
-        done = operate(*action, charge ? Activity::charging : Activity::operating);
+    Status done;
+    if (commanded) {
+      done = resume_action(*commanded, destination);  // an operation under way is completed first
+    } else {
+      if (end_if_withdrawn(name)) return;
+      done = drive_to(destination.location, Activity::driving, options_.route_limit);
+      if (end_if_withdrawn(name)) return;
+      if (done) {
+        if (auto action = operation_action(destination)) {
+          const bool charge = action->kind == ran::ActionKind::charge;
+          if (charge && !action->parameters.count("target")) action->parameters["target"] = std::to_string(options_.charge_to);
+          done = operate(*action, charge ? Activity::charging : Activity::operating, true);
+        }
       }
     }
     if (done && !last && end_if_withdrawn(name)) return;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include <spdlog/spdlog.h>
 
 #include "drover/dds/wire_error.hpp"
@@ -39,11 +41,13 @@ msg::OrderState to_wire(OrderState state) {
 }  // namespace
 
 LogicalAgent::LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock,
-                           LogicalAgentOptions options)
+                           LogicalAgentOptions options, std::optional<OrderJournal> journal)
     : topology_(std::move(topology)),
       clock_(clock),
       options_(std::move(options)),
-      book_([this](const Order& order) { publish_progress(order); }),
+      book_([this](const Order& order) { publish_progress(order); }, OrderBook::kEndedKept,
+            [this](const Order& order, bool added) { return record_order(order, added); }),
+      journal_(std::move(journal)),
       monitor_(topology_),
       command_prefix_(std::to_string(SharedClock::unix_now())),
       route_ids_(static_cast<std::uint64_t>(SharedClock::unix_now())) {}
@@ -58,7 +62,19 @@ Result<std::unique_ptr<LogicalAgent>> LogicalAgent::create(std::shared_ptr<const
     return fail(ErrorCode::invalid_argument, "charge_to: " + *problem);
   }
   if (options.vehicle.id.empty()) options.vehicle.id = options.participant.agent_id;
-  std::unique_ptr<LogicalAgent> agent(new LogicalAgent(std::move(topology), clock, std::move(options)));
+  std::optional<OrderJournal> journal;
+  std::vector<Order> stored;
+  if (!options.order_journal.empty()) {
+    auto opened = OrderJournal::open(options.order_journal, options.participant.agent_id);
+    if (!opened) return unexpected(std::move(opened).error());
+    auto loaded = opened->load();
+    if (!loaded) return unexpected(std::move(loaded).error());
+    journal = std::move(*opened);
+    stored = std::move(*loaded);
+  }
+  std::unique_ptr<LogicalAgent> agent(
+      new LogicalAgent(std::move(topology), clock, std::move(options), std::move(journal)));
+  agent->restored_ = std::move(stored);
   if (auto started = agent->start(); !started) return unexpected(started.error());
   return agent;
 }
@@ -83,6 +99,9 @@ Status LogicalAgent::start() {
   auto make_way = dds::Writer<msg::MakeWayRequest>::create(*participant_, kMakeWayTopic, dds::TopicQos::events());
   if (!make_way) return unexpected(make_way.error());
   make_way_writer_ = std::move(*make_way);
+  // Before the RAN's statuses (an adopted action's outcome is followed from the first) and
+  // before orders can arrive (their names are checked against the restored ones).
+  restore_orders(std::exchange(restored_, {}));
 
   dds::HeartbeatOptions beat;
   beat.kind = "logical";
@@ -248,7 +267,8 @@ void LogicalAgent::on_status(const ran::VehicleStatus& status) {
     status_ = status;
     status_received_ = std::chrono::steady_clock::now();
     for (const auto& command : status.commands) {
-      if (ran::is_terminal(command.state) && command.id.rfind(command_prefix_, 0) == 0) {
+      if (ran::is_terminal(command.state) &&
+          (command.id.rfind(command_prefix_, 0) == 0 || command.id == adopted_command_)) {
         ended_commands_.emplace(command.id, command);
       }
     }
@@ -273,6 +293,33 @@ void LogicalAgent::publish_progress(const Order& order) {
   if (auto written = progress_writer_->write(progress); !written) {
     spdlog::warn("order progress not published: {}", written.error().message);
   }
+}
+
+Status LogicalAgent::record_order(const Order& order, bool added) {
+  if (!journal_) return {};
+  Status stored = added ? journal_->add(order) : journal_->update(order);
+  if (!stored) {
+    // A new order is refused instead (its sender hears why); a change is stored later.
+    if (!added) unsaved_orders_[order.name] = order;
+    if (!journal_failing_) {
+      journal_failing_ = true;
+      raise_alarm(msg::ALARM_CRITICAL,
+                  fmt::format("vehicle '{}': its order journal cannot be written ({}): new orders are refused while "
+                              "it lasts, and a restart of its agent now would lose or repeat work",
+                              vehicle_id(), stored.error().message));
+    }
+    return stored;
+  }
+  unsaved_orders_.erase(order.name);
+  for (auto it = unsaved_orders_.begin(); it != unsaved_orders_.end();) {
+    if (!journal_->update(it->second)) return stored;
+    it = unsaved_orders_.erase(it);
+  }
+  if (journal_failing_) {
+    journal_failing_ = false;
+    raise_alarm(msg::ALARM_INFO, fmt::format("vehicle '{}': its order journal is written again", vehicle_id()));
+  }
+  return stored;
 }
 
 void LogicalAgent::raise_alarm(msg::AlarmSeverity severity, const std::string& text) {

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -28,6 +29,7 @@
 #include "agents/logical_agent/src/footprint_monitor.hpp"
 #include "agents/logical_agent/src/late_grants.hpp"
 #include "agents/logical_agent/src/order_book.hpp"
+#include "agents/logical_agent/src/order_journal.hpp"
 #include "agents/logical_agent/src/route_tracker.hpp"
 #include "agents/logical_agent/src/topology_services.hpp"
 #include "drover/carp/vehicle.hpp"
@@ -76,14 +78,18 @@ struct LogicalAgentOptions {
   std::chrono::milliseconds call_timeout{3000};
   std::chrono::milliseconds route_timeout{10000};
   std::chrono::milliseconds allocate_wait{300};
+  /// The order journal (docs/logical-agent.md "Persistence"): the orders an earlier life
+  /// stored are restored on start, and every change is stored before it is acknowledged or
+  /// published. Empty: none (orders do not survive a restart).
+  std::filesystem::path order_journal;
 };
 
 /// Serves from create() until destroyed.
 class LogicalAgent {
  public:
   /// \return the agent (its executor started), or invalid_argument (bad vehicle profile,
-  ///         lookahead 0, charging thresholds charging_problem refuses), or the DDS layer's
-  ///         errors.
+  ///         lookahead 0, charging thresholds charging_problem refuses), the order journal's
+  ///         errors (OrderJournal::open, load), or the DDS layer's errors.
   static Result<std::unique_ptr<LogicalAgent>> create(std::shared_ptr<const topology::Topology> topology,
                                                       SharedClock clock, LogicalAgentOptions options);
   /// Stops the executor (cancelling the current route's future reservations), then the
@@ -100,8 +106,20 @@ class LogicalAgent {
   /// vehicle stands where its commanded moves took it).
   enum class FollowResult { arrived, replan, failed, withdrawn };
 
-  LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options);
+  LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options,
+               std::optional<OrderJournal> journal);
   Status start();
+
+  // ---- the order journal (restore in take_over.cpp, record in logical_agent.cpp) ----
+  /// Before the executor and the services start: fills the book with the orders an earlier
+  /// life stored (publishing their progress). An unfinished order with a destination that
+  /// is no longer a vertex of the topology fails. A running order's action the earlier life
+  /// commanded is adopted: its outcome is awaited (resume_action), not commanded again.
+  void restore_orders(std::vector<Order> orders);
+  /// The book's recorder: stores `order` in the journal. A failure raises an ALARM_CRITICAL
+  /// (once until the journal is written again) and keeps the order to be stored again with
+  /// the next change. \pre mutex_ is held (the book calls it)
+  Status record_order(const Order& order, bool added);
 
   /// Reader options for an event topic, keeping only samples whose `field` is this vehicle.
   dds::ReaderOptions events_naming_this_vehicle(const std::string& field) const;
@@ -181,8 +199,19 @@ class LogicalAgent {
   Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience,
                   std::optional<RouteTracker> planned = std::nullopt);
   FollowResult follow(std::string& failure);
-  /// Performs an action where the vehicle stands. \return success or why it failed.
-  Status operate(const ran::ActionCommand& action, Activity activity);
+  /// Performs an action where the vehicle stands; `for_order`: the running order's operation
+  /// (its command is recorded first, OrderBook::action_commanded). \return success or why
+  /// it failed.
+  Status operate(const ran::ActionCommand& action, Activity activity, bool for_order = false);
+  /// Waits for the end of action `command` (named `name` in messages) on the RAN.
+  /// \return success when it finished, otherwise why not.
+  Status await_action(const ran::CommandId& command, const std::string& name);
+  /// The running order was restored with its operation at `destination` commanded as
+  /// `command` by an earlier life: waits for that command's outcome. \return success when
+  /// it finished; why not when it failed, or when the RAN does not report it (it restarted
+  /// too, or never got it): whether the operation was done is unknown then, and doing it
+  /// again could load or unload twice.
+  Status resume_action(const ran::CommandId& command, const Destination& destination);
   void execute_order();
   /// Whether the running order is being withdrawn.
   bool order_withdrawn();
@@ -262,6 +291,16 @@ class LogicalAgent {
   std::optional<ran::VehicleStatus> status_;
   std::chrono::steady_clock::time_point status_received_{};
   std::map<ran::CommandId, ran::CommandProgress> ended_commands_;  ///< ours, once terminal
+  /// The action of the restored running order an earlier life commanded, until its outcome
+  /// is known: followed as this life's own commands are (ended_commands_), and not
+  /// cancelled as other commands of earlier lives are (earlier_commands_running).
+  std::optional<ran::CommandId> adopted_command_;
+  std::optional<OrderJournal> journal_;
+  /// Orders whose latest change the journal failed to store, to be stored with the next.
+  std::map<std::string, Order> unsaved_orders_;
+  bool journal_failing_ = false;  ///< the operator was told; until the journal is written again
+  /// The orders an earlier life stored, from create() to start() (restore_orders).
+  std::vector<Order> restored_;
   /// The latest request to make way for another vehicle.
   struct MakeWay {
     std::string requester;

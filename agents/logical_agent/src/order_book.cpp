@@ -58,6 +58,10 @@ Result<std::size_t> OrderBook::add(Order order, TimeNs now) {
   order.destination = 0;
   order.created = now;
   orders_.push_back(std::move(order));
+  if (Status stored = record(orders_.back(), true); !stored) {
+    orders_.pop_back();
+    return unexpected(std::move(stored).error());
+  }
   publish(orders_.back());
   return static_cast<std::size_t>(std::count_if(orders_.begin(), orders_.end(), [](const Order& o) {
     return o.state == OrderState::queued || o.state == OrderState::running;
@@ -79,7 +83,7 @@ const Order* OrderBook::start_next(TimeNs now) {
     if (order.state != OrderState::queued) continue;
     order.state = OrderState::running;
     order.started = now;
-    publish(order);
+    changed(order);
     return &order;
   }
   return nullptr;
@@ -89,14 +93,22 @@ bool OrderBook::advance(TimeNs now) {
   Order* order = running();
   if (order == nullptr) return false;
   ++order->destination;
+  order->action_command.reset();
   if (order->destination >= order->destinations.size()) {
     order->state = OrderState::finished;
     order->finished = now;
     publish_ended(*order);
     return false;
   }
-  publish(*order);
+  changed(*order);
   return true;
+}
+
+void OrderBook::action_commanded(const std::string& command) {
+  Order* order = running();
+  if (order == nullptr) return;
+  order->action_command = command;
+  (void)record(*order);  // failures are the recorder's to report (see Recorder)
 }
 
 void OrderBook::fail_current(const std::string& reason, TimeNs now) {
@@ -120,7 +132,10 @@ Result<OrderState> OrderBook::withdraw(const std::string& name, const std::strin
       publish_ended(order);  // may forget it: `order` is not read again
       return OrderState::withdrawn;
     case OrderState::running:
-      if (!order.withdrawal) order.withdrawal = reason;
+      if (!order.withdrawal) {
+        order.withdrawal = reason;
+        (void)record(order);  // failures are the recorder's to report (see Recorder)
+      }
       break;
     case OrderState::finished:
     case OrderState::failed:
@@ -146,9 +161,23 @@ void OrderBook::end_withdrawn(TimeNs now) {
   publish_ended(*order);
 }
 
+void OrderBook::restore(std::vector<Order> orders) {
+  for (Order& order : orders) {
+    orders_.push_back(std::move(order));
+    publish(orders_.back());
+    const OrderState state = orders_.back().state;
+    if (state != OrderState::queued && state != OrderState::running) ++ended_;
+  }
+  forget_oldest_ended();
+}
+
 void OrderBook::publish_ended(const Order& order) {
-  publish(order);
+  changed(order);
   ++ended_;
+  forget_oldest_ended();
+}
+
+void OrderBook::forget_oldest_ended() {
   while (ended_ > ended_kept_ && !orders_.empty()) {
     const OrderState state = orders_.front().state;
     if (state == OrderState::queued || state == OrderState::running) break;  // older ended ones wait behind it

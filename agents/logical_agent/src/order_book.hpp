@@ -42,6 +42,9 @@ struct Order {
   std::string failure;  ///< failed: why; withdrawn: the reason given
   /// Running, to be withdrawn (the executor ends it once the vehicle stands): the reason.
   std::optional<std::string> withdrawal;
+  /// Running: the RAN command of the current destination's operation, once commanded, so
+  /// that an agent restarted meanwhile looks for its outcome instead of doing it again.
+  std::optional<std::string> action_command;
 };
 
 /// The RAN action an operation asks for at its location; nullopt when it asks for none
@@ -71,22 +74,37 @@ class OrderBook {
  public:
   /// Called with the order after every change (queued, started, advanced, ended).
   using Observer = std::function<void(const Order&)>;
+  /// Stores the order durably after every change, before the observer hears of it
+  /// (`added`: a new order), including those the observer is not told of (a withdrawal
+  /// marked, an action commanded). A failure refuses a new order (add returns it, nothing
+  /// is queued); after any other change the book goes on, since the vehicle's work must
+  /// not stop for a full disk: the recorder deals with it.
+  using Recorder = std::function<Status(const Order&, bool added)>;
   /// How many ended orders are kept for lookups (name conflicts, late withdrawals) by default.
   static constexpr std::size_t kEndedKept = 1000;
   /// \param ended_kept  ended orders kept, the oldest forgotten first (an agent runs for
   ///                    months: its book must not grow with every order it ever ran); a
   ///                    forgotten order's name may be used again
-  explicit OrderBook(Observer observer, std::size_t ended_kept = kEndedKept)
-      : observer_(std::move(observer)), ended_kept_(ended_kept) {}
+  explicit OrderBook(Observer observer, std::size_t ended_kept = kEndedKept, Recorder recorder = {})
+      : observer_(std::move(observer)), recorder_(std::move(recorder)), ended_kept_(ended_kept) {}
+
+  /// Fills an empty book with orders an earlier life of the agent stored, oldest first (at
+  /// most one running), and tells the observer of each (not the recorder: they are stored).
+  /// The oldest ended ones beyond ended_kept are forgotten.
+  void restore(std::vector<Order> orders);
 
   /// Queues `order` at `now`. \return its 1-based position among the unfinished orders,
-  ///         or conflict when an order of that name is known (nothing changes).
+  ///         conflict when an order of that name is known, or the recorder's error
+  ///         (nothing changes on error).
   Result<std::size_t> add(Order order, TimeNs now);
 
   /// The order being executed, if any.
   const Order* current() const;
   /// Starts the oldest queued order at `now` when none runs. \return the running order.
   const Order* start_next(TimeNs now);
+  /// The running order's operation at its current destination was commanded to the RAN as
+  /// `command` (recorded, not published: its progress is the same).
+  void action_commanded(const std::string& command);
   /// The running order's current destination is done: moves to the next one.
   /// \return true when the order has more destinations; false when it finished (at `now`).
   bool advance(TimeNs now);
@@ -113,12 +131,23 @@ class OrderBook {
   void publish(const Order& order) const {
     if (observer_) observer_(order);
   }
-  /// Publishes `order`, which has just ended, then forgets the oldest ended orders beyond
-  /// ended_kept_, `order` itself possibly (not to be read afterwards). Only from the front:
-  /// pointers to the others (current()) stay valid.
+  Status record(const Order& order, bool added = false) const {
+    return recorder_ ? recorder_(order, added) : Status{};
+  }
+  /// Records, then publishes, a change of a known order.
+  void changed(const Order& order) const {
+    (void)record(order);  // failures are the recorder's to report (see Recorder)
+    publish(order);
+  }
+  /// Forgets the oldest ended orders beyond ended_kept_ (only from the front: pointers to
+  /// the others, current(), stay valid).
+  void forget_oldest_ended();
+  /// Records and publishes `order`, which has just ended, then forgets the oldest ended
+  /// orders beyond ended_kept_, `order` itself possibly (not to be read afterwards).
   void publish_ended(const Order& order);
 
   Observer observer_;
+  Recorder recorder_;
   std::size_t ended_kept_;
   std::size_t ended_ = 0;     ///< ended orders in orders_
   std::deque<Order> orders_;  ///< in arrival order; ended ones stay for lookups (see ended_kept_)

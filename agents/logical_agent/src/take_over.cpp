@@ -1,5 +1,6 @@
-// The logical agent taking over from an earlier life of itself (a crash, a kill -9): what
-// that life left at the topology agents, and commands it gave that the RAN still runs.
+// The logical agent taking over from an earlier life of itself (a crash, a kill -9): the
+// orders it stored, what it left at the topology agents, and commands it gave that the RAN
+// still runs.
 
 #include <algorithm>
 
@@ -16,6 +17,68 @@ namespace {
 /// life left: the vehicle is not protected by a hold of its vertex until then.
 constexpr std::chrono::seconds kTakeOverPatience{5};
 }  // namespace
+
+void LogicalAgent::restore_orders(std::vector<Order> orders) {
+  if (!journal_) return;
+  const TimeNs now = clock_.now();
+  std::size_t unfinished = 0;
+  std::lock_guard lock(mutex_);
+  for (Order& order : orders) {
+    const bool open = order.state == OrderState::queued || order.state == OrderState::running;
+    std::optional<std::string> lost;
+    for (std::size_t i = 0; i < order.destinations.size(); ++i) {
+      Destination& destination = order.destinations[i];
+      const auto entity = topology_->find(destination.location_id);
+      if (entity && topology_->is_vertex(*entity)) {
+        destination.location = *entity;
+      } else if (!lost) {
+        lost = fmt::format("destination {}: '{}' is not a vertex of topology '{}'", i, destination.location_id,
+                           topology_->name());
+      }
+    }
+    if (open && lost) {
+      // Stored for another topology file (edited since): it cannot be driven.
+      order.state = OrderState::failed;
+      order.finished = now;
+      order.failure = "restored after a restart of the agent, but " + *lost;
+      if (Status stored = record_order(order, false); !stored) spdlog::error("{}", stored.error().message);
+      spdlog::error("order '{}' failed: {}", order.name, order.failure);
+      continue;
+    }
+    if (!open) continue;
+    ++unfinished;
+    if (order.state == OrderState::running && order.action_command) adopted_command_ = order.action_command;
+  }
+  const std::size_t count = orders.size();
+  book_.restore(std::move(orders));
+  spdlog::info("order journal {}: {} order(s) restored, {} of them unfinished", journal_->file().string(), count,
+               unfinished);
+}
+
+Status LogicalAgent::resume_action(const ran::CommandId& command, const Destination& destination) {
+  const std::string what =
+      fmt::format("action '{}' at '{}' (RAN command '{}')", destination.operation, destination.location_id, command);
+  set_activity(destination.operation == "charge" ? Activity::charging : Activity::operating);
+  bool reported = false;
+  if (const auto status = latest_status()) {
+    reported = std::any_of(status->commands.begin(), status->commands.end(),
+                           [&](const ran::CommandProgress& progress) { return progress.id == command; });
+  }
+  Status outcome;
+  if (!reported) {
+    outcome = fail(ErrorCode::unavailable,
+                   "the logical agent restarted while " + what +
+                       " was under way, and the RAN does not report that command: whether it was done is unknown "
+                       "(check the vehicle, then send the rest of the order again)");
+  } else {
+    spdlog::info("restored order: waiting for the outcome of {}, commanded by an earlier life", what);
+    outcome = await_action(command, destination.operation);
+  }
+  std::lock_guard lock(mutex_);
+  adopted_command_.reset();
+  ended_commands_.erase(command);
+  return outcome;
+}
 
 bool LogicalAgent::take_over() {
   const auto give_up = std::chrono::steady_clock::now() + kTakeOverPatience;
@@ -54,8 +117,14 @@ bool LogicalAgent::take_over() {
 
 bool LogicalAgent::earlier_commands_running(const ran::VehicleStatus& status) {
   const std::string ours = command_prefix_ + "-";
+  std::optional<ran::CommandId> adopted;
+  {
+    std::lock_guard lock(mutex_);
+    adopted = adopted_command_;
+  }
+  // The adopted action is the restored order's to wait for (resume_action), however long.
   const auto running = std::find_if(status.commands.begin(), status.commands.end(), [&](const auto& command) {
-    return !ran::is_terminal(command.state) && command.id.rfind(ours, 0) != 0;
+    return !ran::is_terminal(command.state) && command.id.rfind(ours, 0) != 0 && command.id != adopted;
   });
   const TimeNs now = clock_.now();
   if (running == status.commands.end()) {
