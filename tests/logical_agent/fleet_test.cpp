@@ -1,13 +1,14 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 45..48, 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 45..49, 69, 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
@@ -453,6 +454,27 @@ class FleetTest : public ::testing::Test {
     for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
   }
 
+  /// The infrastructure, and V1 on left-0 (a load takes it 20 s) whose logical agent keeps an
+  /// order journal (its options go to `logical`); sends V1 order "pallet" (load at left-4,
+  /// unload at right-4) and order "home" (to left-0) behind it, and waits until V1 loads at
+  /// left-4. Call through ASSERT_NO_FATAL_FAILURE.
+  void start_v1_loading_with_an_order_journal(Fleet& fleet, std::uint32_t domain, std::vector<std::string>& logical) {
+    fleet.start_infrastructure();
+    watch(domain, fleet, {"V1"});
+    fleet.start_ran("V1", "left-0", {"--load-duration", "20"});
+    logical = {"--park-after", "-1", "--charge-below", "0", "--db", (fleet.dir() / "V1.db").string()};
+    fleet.start_logical("V1", logical);
+    ASSERT_TRUE(wait_ready("V1", "left-0"));
+    ASSERT_EQ(send_order("V1", "pallet", {{"left-4", "load"}, {"right-4", "unload"}}), "");
+    ASSERT_EQ(send_order("V1", "home", {{"left-0", "NOP"}}), "");
+    const auto left4 = world_->vertex(*world_->find("left-4")).position;
+    ASSERT_TRUE(wait_status("V1", [&](const ran::VehicleStatus& s) {
+      return std::hypot(s.pose.x - left4.x(), s.pose.y - left4.y()) < 0.05 && s.linear_speed == 0 &&
+             std::any_of(s.commands.begin(), s.commands.end(),
+                         [](const ran::CommandProgress& c) { return c.state == ran::CommandState::running; });
+    })) << "V1 never loaded at left-4";
+  }
+
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
   bool wait_ready(const std::string& vehicle, const std::string& vertex) {
     return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
@@ -702,6 +724,57 @@ TEST_F(FleetTest, ALogicalAgentRestartedAfterACrashTakesOverItsVehicleAndFreesTh
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
   for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
+TEST_F(FleetTest, ALogicalAgentRestartedFromItsOrderJournalAwaitsTheLoadItCommandedAndFinishesItsOrders) {
+  constexpr std::uint32_t kDomain = 49;
+  Fleet fleet(kDomain, "order-journal");
+  std::vector<std::string> logical;
+  ASSERT_NO_FATAL_FAILURE(start_v1_loading_with_an_order_journal(fleet, kDomain, logical));
+
+  // The agent crashes while the RAN loads; its next life reads the journal.
+  ASSERT_NO_FATAL_FAILURE(fleet.crash_and_restart("V1"));
+  // The load it commanded is awaited, not commanded again (the simulated vehicle fails a
+  // second load, "already_loaded"), and the orders run on.
+  const auto pallet = wait_order("pallet");
+  ASSERT_TRUE(pallet.has_value()) << "the order running at the crash did not end";
+  EXPECT_EQ(pallet->state(), msg::ORDER_FINISHED) << pallet->failure();
+  EXPECT_EQ(pallet->destination(), 2u);
+  // It knows its orders again: a name in use is refused.
+  const std::string again = send_order("V1", "home", {{"left-0", "NOP"}});
+  EXPECT_NE(again.find("known already"), std::string::npos) << again;
+  const auto home = wait_order("home");
+  ASSERT_TRUE(home.has_value()) << "the order queued at the crash did not end";
+  EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_EQ(seen_.latest["V1"].load, ran::LoadState::empty) << "unloaded at right-4";
+  EXPECT_EQ(seen_.holders["left-0"], "V1");
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  for (const auto& alarm : seen_.alarms) ADD_FAILURE() << "alarm: " << alarm.text();
+}
+
+TEST_F(FleetTest, AnActionTheRanNoLongerKnowsFailsTheRestoredOrderWithAnAlarmAndTheQueueRunsOn) {
+  constexpr std::uint32_t kDomain = 69;
+  Fleet fleet(kDomain, "order-journal-ran-lost");
+  std::vector<std::string> logical;
+  ASSERT_NO_FATAL_FAILURE(start_v1_loading_with_an_order_journal(fleet, kDomain, logical));
+
+  // The agent and the vehicle's RAN both go down mid-load; the RAN comes back knowing no
+  // command, so whether the pallet is on board is unknown.
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("V1"));
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("ran-V1"));
+  fleet.start_ran("V1", "left-4", {"--load-duration", "20"});
+  fleet.start_logical("V1", logical);
+  const auto pallet = wait_order("pallet");
+  ASSERT_TRUE(pallet.has_value()) << "the order running at the crash did not end";
+  EXPECT_EQ(pallet->state(), msg::ORDER_FAILED);
+  EXPECT_NE(pallet->failure().find("whether it was done is unknown"), std::string::npos) << pallet->failure();
+  const auto home = wait_order("home");
+  ASSERT_TRUE(home.has_value()) << "the order queued at the crash did not end";
+  EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(alarm_seen(msg::ALARM_ERROR, "V1", "order 'pallet' of vehicle 'V1' failed"));
 }
 
 TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNoLiveOwner) {
