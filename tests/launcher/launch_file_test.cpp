@@ -46,7 +46,7 @@ TEST(LaunchFile, GoodFileBecomesCommandLines) {
       {"kind": "topology", "db": "loop.db", "restart": "on-failure", "max_restarts": 2},
       {"kind": "routing", "id": "routing-1"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "profile": "slow", "loaded": true},
-      {"kind": "logical", "vehicle": "V1", "profile": "slow", "lookahead": 3},
+      {"kind": "logical", "vehicle": "V1", "profile": "slow", "lookahead": 3, "db": "V1-orders.db"},
       {"kind": "load-generator", "seed": 7, "stations": ["station", "parking"]})"));
   ASSERT_TRUE(parsed.has_value()) << parsed.error().front().where << ": " << parsed.error().front().what;
   EXPECT_EQ(parsed->domain_id, 226u);
@@ -73,8 +73,9 @@ TEST(LaunchFile, GoodFileBecomesCommandLines) {
                                                    "--max-speed", "0.5"}));
   const auto& logical = parsed->agents[3];
   EXPECT_EQ(logical.id, "V1");
-  EXPECT_EQ(logical.options, (std::vector<std::string>{"--id", "V1", "--topology", topology, "--lookahead", "3",
-                                                       "--vehicle", "/state/V1.vehicle.json"}));
+  EXPECT_EQ(logical.options, (std::vector<std::string>{"--id", "V1", "--topology", topology, "--db",
+                                                       "/state/V1-orders.db", "--lookahead", "3", "--vehicle",
+                                                       "/state/V1.vehicle.json"}));
   // The logical agent plans with the profile's speeds: its file is written before it starts.
   ASSERT_EQ(logical.files.size(), 1u);
   EXPECT_EQ(logical.files[0].first, "/state/V1.vehicle.json");
@@ -234,8 +235,12 @@ TEST(LaunchFile, DuplicateIdsAndVehicles) {
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"},
       {"kind": "ran-sim", "vehicle": "V1", "id": "other", "at": "north-east"},
       {"kind": "logical", "vehicle": "V2", "id": "V3"},
-      {"kind": "ran-sim", "vehicle": "V4", "id": "bad id!", "at": "charger"})"));
+      {"kind": "ran-sim", "vehicle": "V4", "id": "bad id!", "at": "charger"},
+      {"kind": "topology", "db": "shared.db"}, {"kind": "logical", "vehicle": "V5", "db": "/state/shared.db"})"));
   EXPECT_NE(text.find("agents[1].id: agent id 'routing' is used by agents[0] too"), std::string::npos) << text;
+  EXPECT_NE(text.find("agents[7].db: journal /state/shared.db is agents[6].db's too (one journal per agent)"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("agents[3].vehicle: vehicle 'V1' has a ran-sim at agents[2] already"), std::string::npos)
       << text;
   EXPECT_NE(text.find("agents[4].id: a logical agent's id is its vehicle id"), std::string::npos) << text;

@@ -874,6 +874,12 @@ void LogicalAgent::execute_order() {
     }
     if (done && !last && end_if_withdrawn(name)) return;
     if (!done) {
+      if (stopping_ && journal_) {
+        // Stopped, not failed: the journal has it running (with its action, if commanded),
+        // and the next life goes on with it.
+        spdlog::info("order '{}' stays running in the order journal for the next life", name);
+        return;
+      }
       if (!stopping_) {
         raise_alarm(msg::ALARM_ERROR, "order '" + name + "' of vehicle '" + vehicle_id() + "' failed: " + done.error().message);
       }
