@@ -3,6 +3,7 @@
 #include "agents/sqlite/database.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <utility>
 
 namespace drover::sqlite {
@@ -172,7 +173,12 @@ Status Database::each_row(const char* sql, const char* table, const std::functio
 
 Status Database::transaction(const std::string& what, const std::function<Status()>& body) {
   if (Status ok = exec("BEGIN IMMEDIATE", "start " + what); !ok) return ok;
-  Status done = body();
+  Status done;
+  try {
+    done = body();
+  } catch (const std::exception& e) {  // never left open: every later transaction would fail
+    done = fail(ErrorCode::internal, where() + ": " + what + ": " + e.what());
+  }
   if (done) done = exec("COMMIT", "commit " + what);
   if (!done) sqlite3_exec(connection_->db, "ROLLBACK", nullptr, nullptr, nullptr);
   return done;

@@ -127,7 +127,7 @@ class Database {
   /// Runs `sql`, handing each row to `read`; stops at the first reader or SQLite error.
   Status each_row(const char* sql, const char* table, const std::function<void(RowReader&)>& read);
   /// Runs `body` in one write transaction (BEGIN IMMEDIATE): committed when it succeeds,
-  /// rolled back when it or the commit fails.
+  /// rolled back when it or the commit fails, or it throws (internal, with its message).
   Status transaction(const std::string& what, const std::function<Status()>& body);
   /// Runs `body` in one read transaction, so that it sees one state of the file.
   Status read_transaction(const std::string& what, const std::function<Status()>& body);

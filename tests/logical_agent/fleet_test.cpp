@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 45..49, 69, 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 45..49, 69, 83..93 and 99..102. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -775,6 +775,24 @@ TEST_F(FleetTest, AnActionTheRanNoLongerKnowsFailsTheRestoredOrderWithAnAlarmAnd
   EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
   std::lock_guard lock(seen_.mutex);
   EXPECT_TRUE(alarm_seen(msg::ALARM_ERROR, "V1", "order 'pallet' of vehicle 'V1' failed"));
+}
+
+TEST_F(FleetTest, ARanRestartedMidLoadFailsTheOrderInsteadOfLeavingItWaitingForEver) {
+  constexpr std::uint32_t kDomain = 102;
+  Fleet fleet(kDomain, "ran-restart-mid-load");
+  std::vector<std::string> logical;
+  ASSERT_NO_FATAL_FAILURE(start_v1_loading_with_an_order_journal(fleet, kDomain, logical));
+  // Only the RAN goes down, and comes back at once knowing no command: the load the agent
+  // waits for will never end (before, the order waited for it for ever).
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("ran-V1"));
+  fleet.start_ran("V1", "left-4", {"--load-duration", "20"});
+  const auto pallet = wait_order("pallet");
+  ASSERT_TRUE(pallet.has_value()) << "the order loading when the RAN restarted did not end";
+  EXPECT_EQ(pallet->state(), msg::ORDER_FAILED);
+  EXPECT_NE(pallet->failure().find("is no longer reported by the RAN"), std::string::npos) << pallet->failure();
+  const auto home = wait_order("home");
+  ASSERT_TRUE(home.has_value()) << "the order queued behind it did not end";
+  EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
 }
 
 TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNoLiveOwner) {

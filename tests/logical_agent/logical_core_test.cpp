@@ -221,7 +221,7 @@ TEST(OrderBook, RecordsEveryChangeBeforePublishingAndARecordingFailureRefusesANe
   ASSERT_TRUE(a && b);
   ASSERT_TRUE(book.add(*a, 10));
   ASSERT_EQ(book.start_next(20)->name, "a");
-  book.action_commanded("c-1");
+  EXPECT_TRUE(book.action_commanded("c-1"));
   EXPECT_TRUE(book.advance(30));  // the next destination has no action commanded yet
   ASSERT_TRUE(book.withdraw("a", "line stopped", 40));
 
@@ -231,6 +231,8 @@ TEST(OrderBook, RecordsEveryChangeBeforePublishingAndARecordingFailureRefusesANe
   EXPECT_EQ(refused.error().code, ErrorCode::io);
   EXPECT_EQ(book.find("b"), nullptr) << "a refused order is not queued";
   EXPECT_EQ(book.queued_count(), 0u);
+  // An action that cannot be recorded is told so (the agent does not command it).
+  EXPECT_EQ(book.action_commanded("c-2").error().code, ErrorCode::io);
   book.end_withdrawn(60);  // other changes go on, published though not recorded
   EXPECT_EQ(book.find("a")->state, OrderState::withdrawn);
 

@@ -134,6 +134,23 @@ TEST_F(OrderJournalTest, KeepsTheNewestEndedOrdersAndAForgottenNameComesBackLast
   EXPECT_EQ(names(*loaded), (std::vector<std::string>{"d:finished", "e:queued", "c:queued"}));
 }
 
+TEST_F(OrderJournalTest, AnOrderWithTextThatIsNotUtf8IsRefusedAndTheJournalGoesOn) {
+  auto journal = OrderJournal::open(file(), "V1");
+  ASSERT_TRUE(journal) << journal.error().message;
+  auto bad = order("bad");
+  bad.destinations[0].properties["pallet"] = "p-\xff";  // DDS strings carry any bytes
+  const auto refused = journal->add(bad);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(refused.error().message.find("order 'bad' cannot be stored"), std::string::npos)
+      << refused.error().message;
+  // Nothing of it stored, and no transaction left open.
+  ASSERT_TRUE(journal->add(order("good")));
+  const auto loaded = journal->load();
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_EQ(names(*loaded), (std::vector<std::string>{"good:queued"}));
+}
+
 TEST_F(OrderJournalTest, AnotherVehiclesJournalAnotherKindOfFileAndOneInUseAreRefusedNamingTheFile) {
   {
     auto journal = OrderJournal::open(file(), "V1");

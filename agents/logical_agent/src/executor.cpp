@@ -72,11 +72,13 @@ void LogicalAgent::run() {
     const bool battery_low = status && options_.charge_below > 0 &&
                              status->battery.state_of_charge < options_.charge_below && !status->battery.charging;
     bool has_work = false;
+    bool order_running = false;  // only after a restart: an order runs in execute_order otherwise
     {
       std::lock_guard lock(mutex_);
-      has_work = book_.current() != nullptr || book_.queued_count() > 0;
+      order_running = book_.current() != nullptr;
+      has_work = order_running || book_.queued_count() > 0;
     }
-    if (battery_low && clock_.now() >= charge_retry_at_) {
+    if (battery_low && clock_.now() >= charge_retry_at_ && !order_running) {
       go_to_service_vertex(topology::VertexKind::charger);
       continue;
     }
@@ -186,7 +188,12 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
   } else {
     spdlog::debug("cannot hold '{}' yet: {}", topology_->id(vertex), why);
   }
-  if (clock_.now() >= clear_way_at_) {
+  bool action_pending = false;  // the restored order's: the vehicle stays where it operates
+  {
+    std::lock_guard lock(mutex_);
+    action_pending = adopted_command_.has_value();
+  }
+  if (clock_.now() >= clear_way_at_ && !action_pending) {
     clear_way_at_ = clock_.now() + kClearWayRetry;
     if (drive_to_nearest(topology::VertexKind::parking, false)) {
       spdlog::info("vehicle '{}' cleared the way: it holds '{}'", vehicle_id(), topology_->id(*vertex_));
@@ -787,35 +794,51 @@ Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activ
   if (for_order) {
     // Recorded before it is sent: an agent restarted after the RAN got it must not do it again.
     std::lock_guard lock(mutex_);
-    book_.action_commanded(action.id);
+    if (Status recorded = book_.action_commanded(action.id); !recorded) {
+      return fail(recorded.error().code, "action '" + action.name + "' not commanded, since a restart would not know "
+                                         "of it: " + recorded.error().message);
+    }
   }
   auto verdict = ran_->action(action, options_.call_timeout);
   if (!verdict) return fail(verdict.error().code, "the RAN did not take action '" + action.name + "': " + verdict.error().message);
   if (verdict->rejected()) {
     return fail(ErrorCode::not_permitted, "the RAN rejected action '" + action.name + "': " + verdict->code + " " + verdict->reason);
   }
-  return await_action(action.id, action.name);
+  return await_action(action.id, action.name, false);
 }
 
-Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name) {
+Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name, bool listed) {
   for (;;) {
     if (!wait_event()) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     bool replan = false;
     process_notices(replan);
     std::optional<ran::CommandProgress> ended;
+    std::optional<ran::VehicleStatus> status;
     {
+      // Both at once: a status that ends the command records its end before it is the latest.
       std::lock_guard lock(mutex_);
       if (auto found = ended_commands_.find(command); found != ended_commands_.end()) {
         ended = found->second;
         ended_commands_.erase(found);
       }
+      status = status_;
     }
     if (ended) {
       if (ended->state == ran::CommandState::finished) return {};
       return fail(ErrorCode::unavailable, "action '" + name + "' " + ran::to_string(ended->state) + ": " +
                                               ended->code + " " + ended->reason);
     }
-    if (const auto status = latest_status()) {
+    if (status) {
+      // A command stays listed until it ends: a status after one that listed it, without it
+      // and without its end, comes from a RAN that forgot it (restarted).
+      const bool listed_now = std::any_of(status->commands.begin(), status->commands.end(),
+                                          [&](const ran::CommandProgress& progress) { return progress.id == command; });
+      if (listed && !listed_now) {
+        return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command +
+                                                "') is no longer reported by the RAN (it restarted?): whether it "
+                                                "was done is unknown (check the vehicle)");
+      }
+      listed = listed || listed_now;
       if (auto error = check_errors(*status)) {
         if (auto cancelled = ran_->cancel(command, options_.call_timeout); !cancelled) {
           spdlog::warn("cancel of action '{}' not delivered: {}", name, cancelled.error().message);

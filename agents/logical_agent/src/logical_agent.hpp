@@ -203,9 +203,11 @@ class LogicalAgent {
   /// (its command is recorded first, OrderBook::action_commanded). \return success or why
   /// it failed.
   Status operate(const ran::ActionCommand& action, Activity activity, bool for_order = false);
-  /// Waits for the end of action `command` (named `name` in messages) on the RAN.
-  /// \return success when it finished, otherwise why not.
-  Status await_action(const ran::CommandId& command, const std::string& name);
+  /// Waits for the end of action `command` (named `name` in messages) on the RAN; `listed`:
+  /// a status has listed it already. \return success when it finished, otherwise why not
+  /// (it failed or was cancelled, a RAN error, or a status after one that listed it no
+  /// longer does: the RAN forgot it).
+  Status await_action(const ran::CommandId& command, const std::string& name, bool listed);
   /// The running order was restored with its operation at `destination` commanded as
   /// `command` by an earlier life: waits for that command's outcome. \return success when
   /// it finished; why not when it failed, or when the RAN does not report it (it restarted

@@ -63,9 +63,8 @@ Result<std::size_t> OrderBook::add(Order order, TimeNs now) {
     return unexpected(std::move(stored).error());
   }
   publish(orders_.back());
-  return static_cast<std::size_t>(std::count_if(orders_.begin(), orders_.end(), [](const Order& o) {
-    return o.state == OrderState::queued || o.state == OrderState::running;
-  }));
+  return static_cast<std::size_t>(
+      std::count_if(orders_.begin(), orders_.end(), [](const Order& o) { return is_open(o.state); }));
 }
 
 Order* OrderBook::running() {
@@ -104,11 +103,11 @@ bool OrderBook::advance(TimeNs now) {
   return true;
 }
 
-void OrderBook::action_commanded(const std::string& command) {
+Status OrderBook::action_commanded(const std::string& command) {
   Order* order = running();
-  if (order == nullptr) return;
+  if (order == nullptr) return {};
   order->action_command = command;
-  (void)record(*order);  // failures are the recorder's to report (see Recorder)
+  return record(*order);
 }
 
 void OrderBook::fail_current(const std::string& reason, TimeNs now) {
@@ -165,8 +164,7 @@ void OrderBook::restore(std::vector<Order> orders) {
   for (Order& order : orders) {
     orders_.push_back(std::move(order));
     publish(orders_.back());
-    const OrderState state = orders_.back().state;
-    if (state != OrderState::queued && state != OrderState::running) ++ended_;
+    if (!is_open(orders_.back().state)) ++ended_;
   }
   forget_oldest_ended();
 }
@@ -179,8 +177,7 @@ void OrderBook::publish_ended(const Order& order) {
 
 void OrderBook::forget_oldest_ended() {
   while (ended_ > ended_kept_ && !orders_.empty()) {
-    const OrderState state = orders_.front().state;
-    if (state == OrderState::queued || state == OrderState::running) break;  // older ended ones wait behind it
+    if (is_open(orders_.front().state)) break;  // older ended ones wait behind it
     orders_.pop_front();
     --ended_;
   }

@@ -29,6 +29,10 @@ struct Destination {
 
 enum class OrderState { queued, running, finished, failed, withdrawn };
 const char* to_string(OrderState state) noexcept;
+/// Whether an order in `state` has not ended (queued or running).
+constexpr bool is_open(OrderState state) noexcept {
+  return state == OrderState::queued || state == OrderState::running;
+}
 
 struct Order {
   std::string name;
@@ -77,8 +81,9 @@ class OrderBook {
   /// Stores the order durably after every change, before the observer hears of it
   /// (`added`: a new order), including those the observer is not told of (a withdrawal
   /// marked, an action commanded). A failure refuses a new order (add returns it, nothing
-  /// is queued); after any other change the book goes on, since the vehicle's work must
-  /// not stop for a full disk: the recorder deals with it.
+  /// is queued) and is returned by action_commanded; after any other change the book goes
+  /// on, since the vehicle's work must not stop for a full disk: the recorder deals with
+  /// it (a queued order withdrawn meanwhile may then run after a restart).
   using Recorder = std::function<Status(const Order&, bool added)>;
   /// How many ended orders are kept for lookups (name conflicts, late withdrawals) by default.
   static constexpr std::size_t kEndedKept = 1000;
@@ -102,9 +107,11 @@ class OrderBook {
   const Order* current() const;
   /// Starts the oldest queued order at `now` when none runs. \return the running order.
   const Order* start_next(TimeNs now);
-  /// The running order's operation at its current destination was commanded to the RAN as
-  /// `command` (recorded, not published: its progress is the same).
-  void action_commanded(const std::string& command);
+  /// The running order's operation at its current destination is commanded to the RAN as
+  /// `command` (recorded, not published: its progress is the same). \return the
+  /// recorder's error: then the command must not be sent (a restart would not know of it
+  /// and could do the operation twice).
+  Status action_commanded(const std::string& command);
   /// The running order's current destination is done: moves to the next one.
   /// \return true when the order has more destinations; false when it finished (at `now`).
   bool advance(TimeNs now);

@@ -48,14 +48,23 @@ constexpr sqlite::Schema kOrderJournalSchema{"order journal", kSchema, OrderJour
 constexpr std::array kStates{OrderState::queued, OrderState::running, OrderState::finished, OrderState::failed,
                              OrderState::withdrawn};
 
-bool ended(OrderState state) { return state != OrderState::queued && state != OrderState::running; }
-
 std::string destinations_json(const std::vector<Destination>& destinations) {
   auto out = nlohmann::json::array();
   for (const Destination& d : destinations) {
     out.push_back({{"location", d.location_id}, {"operation", d.operation}, {"properties", d.properties}});
   }
-  return out.dump();
+  return out.dump();  // throws on text that is not UTF-8 (store says so)
+}
+
+/// Properties stored as a JSON object of texts, or nullopt for anything else.
+std::optional<std::map<std::string, std::string>> parse_properties(const nlohmann::json& json) {
+  if (!json.is_object()) return std::nullopt;
+  std::map<std::string, std::string> out;
+  for (const auto& [name, value] : json.items()) {
+    if (!value.is_string()) return std::nullopt;
+    out[name] = value.get<std::string>();
+  }
+  return out;
 }
 
 /// The destinations stored by destinations_json, or nullopt for anything else.
@@ -68,27 +77,10 @@ std::optional<std::vector<Destination>> parse_destinations(const std::string& te
         !item.contains("operation") || !item["operation"].is_string() || !item.contains("properties")) {
       return std::nullopt;
     }
-    Destination d;
-    d.location_id = item["location"].get<std::string>();
-    d.operation = item["operation"].get<std::string>();
-    const auto& properties = item["properties"];
-    if (!properties.is_object()) return std::nullopt;
-    for (const auto& [name, value] : properties.items()) {
-      if (!value.is_string()) return std::nullopt;
-      d.properties[name] = value.get<std::string>();
-    }
-    out.push_back(std::move(d));
-  }
-  return out;
-}
-
-std::optional<std::map<std::string, std::string>> parse_properties(const std::string& text) {
-  const auto json = nlohmann::json::parse(text, nullptr, false);
-  if (!json.is_object()) return std::nullopt;
-  std::map<std::string, std::string> out;
-  for (const auto& [name, value] : json.items()) {
-    if (!value.is_string()) return std::nullopt;
-    out[name] = value.get<std::string>();
+    auto properties = parse_properties(item["properties"]);
+    if (!properties) return std::nullopt;
+    out.push_back(Destination{topology::kNoEntity, item["location"].get<std::string>(),
+                              item["operation"].get<std::string>(), std::move(*properties)});
   }
   return out;
 }
@@ -135,8 +127,15 @@ struct OrderJournal::Connection {
   }
 
   Status store(const Order& order) {
-    const std::string destinations = destinations_json(order.destinations);
-    const std::string properties = nlohmann::json(order.properties).dump();
+    std::string destinations, properties;
+    try {
+      destinations = destinations_json(order.destinations);
+      properties = nlohmann::json(order.properties).dump();
+    } catch (const nlohmann::json::exception& e) {
+      return fail(ErrorCode::invalid_argument,
+                  db.where() + ": order '" + order.name + "' cannot be stored: its operations or properties hold "
+                  "text that is not UTF-8 (" + e.what() + ")");
+    }
     return db.run(upsert,
                   {std::string_view(order.name), std::string_view(destinations), std::string_view(properties),
                    std::string_view(to_string(order.state)), static_cast<std::int64_t>(order.destination),
@@ -178,7 +177,7 @@ Status OrderJournal::update(const Order& order) {
   Connection& c = *connection_;
   return c.db.transaction("storing order '" + order.name + "'", [&]() -> Status {
     if (Status ok = c.store(order); !ok) return ok;
-    if (!ended(order.state)) return {};
+    if (!!is_open(order.state)) return {};
     return c.db.run(c.forget_ended, {static_cast<std::int64_t>(c.ended_kept)}, "forget the oldest ended orders");
   });
 }
@@ -199,7 +198,7 @@ Result<std::vector<Order>> OrderJournal::load() {
           } else {
             row.complain(1, "is not a list of destinations");
           }
-          if (auto properties = parse_properties(row.text(2))) {
+          if (auto properties = parse_properties(nlohmann::json::parse(row.text(2), nullptr, false))) {
             order.properties = std::move(*properties);
           } else {
             row.complain(2, "is not an object of text properties");
@@ -214,7 +213,7 @@ Result<std::vector<Order>> OrderJournal::load() {
           }
           order.destination = row.small(4, std::numeric_limits<std::uint32_t>::max());
           // Queued and running orders are at a destination; a finished one is past its last.
-          const std::size_t limit = order.destinations.size() - (ended(order.state) ? 0 : 1);
+          const std::size_t limit = order.destinations.size() - (!is_open(order.state) ? 0 : 1);
           if (!order.destinations.empty() && order.destination > limit) {
             row.complain(4, "is out of range (" + std::to_string(order.destination) + " of " +
                                 std::to_string(order.destinations.size()) + " destinations)");

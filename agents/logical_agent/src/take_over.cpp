@@ -24,7 +24,7 @@ void LogicalAgent::restore_orders(std::vector<Order> orders) {
   std::size_t unfinished = 0;
   std::lock_guard lock(mutex_);
   for (Order& order : orders) {
-    const bool open = order.state == OrderState::queued || order.state == OrderState::running;
+    const bool open = is_open(order.state);
     std::optional<std::string> lost;
     for (std::size_t i = 0; i < order.destinations.size(); ++i) {
       Destination& destination = order.destinations[i];
@@ -42,7 +42,8 @@ void LogicalAgent::restore_orders(std::vector<Order> orders) {
       order.finished = now;
       order.failure = "restored after a restart of the agent, but " + *lost;
       if (Status stored = record_order(order, false); !stored) spdlog::error("{}", stored.error().message);
-      spdlog::error("order '{}' failed: {}", order.name, order.failure);
+      raise_alarm(msg::ALARM_ERROR,
+                  "order '" + order.name + "' of vehicle '" + vehicle_id() + "' failed: " + order.failure);
       continue;
     }
     if (!open) continue;
@@ -58,7 +59,8 @@ void LogicalAgent::restore_orders(std::vector<Order> orders) {
 Status LogicalAgent::resume_action(const ran::CommandId& command, const Destination& destination) {
   const std::string what =
       fmt::format("action '{}' at '{}' (RAN command '{}')", destination.operation, destination.location_id, command);
-  set_activity(destination.operation == "charge" ? Activity::charging : Activity::operating);
+  const auto action = operation_action(destination);
+  set_activity(action && action->kind == ran::ActionKind::charge ? Activity::charging : Activity::operating);
   bool reported = false;
   if (const auto status = latest_status()) {
     reported = std::any_of(status->commands.begin(), status->commands.end(),
@@ -72,7 +74,7 @@ Status LogicalAgent::resume_action(const ran::CommandId& command, const Destinat
                        "(check the vehicle, then send the rest of the order again)");
   } else {
     spdlog::info("restored order: waiting for the outcome of {}, commanded by an earlier life", what);
-    outcome = await_action(command, destination.operation);
+    outcome = await_action(command, destination.operation, true);
   }
   std::lock_guard lock(mutex_);
   adopted_command_.reset();
