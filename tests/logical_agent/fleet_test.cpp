@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 45..49, 69, 83..93 and 99..102. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 45..49, 69, 83..93 and 99..103. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -20,6 +20,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <boost/geometry.hpp>
@@ -828,6 +829,68 @@ TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNo
     ASSERT_TRUE(ended.has_value()) << "order " << order << " did not end";
     EXPECT_EQ(ended->state(), msg::ORDER_FINISHED) << order << ": " << ended->failure();
   }
+}
+
+/// Waits until the file at `path` contains `text` (an agent's log line). \return whether it did.
+bool wait_for_log(const std::filesystem::path& path, const std::string& text, std::chrono::seconds timeout) {
+  const auto give_up = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < give_up) {
+    if (std::filesystem::exists(path) && read_file(path.string()).find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(100ms);
+  }
+  return false;
+}
+
+TEST_F(FleetTest, ALogicalAgentRestartedWhileAPartitionIsDownTakesOverWhatItLeftThereOnceItIsBack) {
+  constexpr std::uint32_t kDomain = 103;
+  Fleet fleet(kDomain, "late-take-over");
+  // The H crossing with its right leg in partition "east", the rest in "west", each served
+  // by a journaling topology agent. V1 stands on the station right-4, in "east".
+  auto json = nlohmann::json::parse(std::ifstream(source_dir() + "/launch/topologies/h_crossing.json"));
+  for (auto* items : {&json["vertices"], &json["edges"]}) {
+    for (auto& item : *items) item["partition"] = item["id"].get<std::string>().rfind("right", 0) == 0 ? "east" : "west";
+  }
+  const auto file = (fleet.dir() / "h_two_partitions.json").string();
+  std::ofstream(file) << json.dump(2);
+  fleet.use_topology(file);
+  for (const char* partition : {"west", "east"}) {
+    fleet.start(std::string("topology-") + partition,
+                {"topology-agent", "--topology", file, "--partition", partition, "--id",
+                 std::string("topology-") + partition, "--db", (fleet.dir() / (std::string(partition) + ".db")).string()});
+  }
+  fleet.start("routing", {"routing-agent"});
+  watch(kDomain, fleet, {"V1", "V2"});
+  fleet.start_vehicle("V1", "right-4");
+  fleet.start_vehicle("V2", "left-0");
+  ASSERT_TRUE(wait_ready("V1", "right-4"));
+  ASSERT_TRUE(wait_ready("V2", "left-0"));
+
+  // "east" goes down, then V1's logical agent crashes and comes back while "east" is down:
+  // its start cannot learn that its earlier life holds the station there open-ended.
+  std::vector<std::string> east;
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("topology-east", &east));
+  ASSERT_NO_FATAL_FAILURE(fleet.crash_and_restart("V1"));
+  ASSERT_TRUE(wait_for_log(fleet.dir() / "V1.restarted.log", "did not say within", 60s))
+      << "V1's next life never gave up asking partition east";
+  // "east" comes back from its journal, the earlier life's hold of the station with it; V1's
+  // heartbeat keeps "east" from sweeping it as departed. V1's next life must take over what
+  // its earlier life left there, or that hold would block the station for ever.
+  fleet.start("topology-east", east);
+  ASSERT_EQ(send_order("V1", "v1-away", {{"left-4", "NOP"}}), "");
+  const auto away = wait_order("v1-away");
+  ASSERT_TRUE(away.has_value()) << "V1's order did not end";
+  EXPECT_EQ(away->state(), msg::ORDER_FINISHED) << away->failure();
+  ASSERT_EQ(send_order("V2", "v2-station", {{"right-4", "NOP"}}), "");
+  const auto station = wait_order("v2-station");
+  ASSERT_TRUE(station.has_value()) << "V2's order did not end";
+  EXPECT_EQ(station->state(), msg::ORDER_FINISHED) << station->failure();
+
+  std::lock_guard lock(seen_.mutex);
+  // Two topology agents number their events apart: only conflicting holds count here.
+  for (const auto& violation : seen_.hold_violations) {
+    if (violation.find(" while ") != std::string::npos) ADD_FAILURE() << violation;
+  }
+  EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
 }
 
 TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesTillTheToldOperatorReleasesIt) {

@@ -58,6 +58,7 @@ void LogicalAgent::run() {
   if (!take_over()) return;
   idle_since_ = clock_.now();
   while (!stopping_) {
+    take_over_late();
     bool replan = false;
     process_notices(replan);
     if (!route_) {
@@ -147,6 +148,13 @@ bool LogicalAgent::hold_position() {
     return false;
   }
   const auto vertex = vertex_under(*status);
+  if (vertex && !take_over_late(topology_->partition(*vertex))) {
+    // What an earlier life holds there is unknown: holding the vertex now would take over
+    // its allocation unknowingly, and leave that life's route (and its turn on the vertex).
+    set_activity(Activity::waiting);
+    pause_before_retry();
+    return false;
+  }
   if (!vertex) {
     set_activity(Activity::error);
     if (!position_alarm_raised_) {
@@ -256,6 +264,7 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
     keep_standing_reserved(*vertex_, 2 * options_.delay_threshold + clock_.to_sim(2 * kRoutePause));
     topology::RouteId id = 0;
     while (id == 0) id = route_ids_();
+    if (!unknown_partitions_.empty()) own_routes_.insert(id);
     msg::RouteRequest request;
     request.agent(vehicle_id());
     request.route(id);

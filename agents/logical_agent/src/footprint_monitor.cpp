@@ -13,8 +13,8 @@ namespace bg = boost::geometry;
 FootprintMonitor::FootprintMonitor(std::shared_ptr<const topology::Topology> topology, double tolerance_m2)
     : topology_(std::move(topology)), tolerance_m2_(tolerance_m2) {}
 
-void FootprintMonitor::hold(topology::EntityIndex entity, HeldStep granted_as) {
-  held_[entity] = Holding{granted_as, true};
+void FootprintMonitor::hold(topology::EntityIndex entity, HeldStep granted_as, bool leftover) {
+  held_[entity] = Holding{granted_as, !leftover};
   area_.reset();
 }
 

@@ -28,8 +28,9 @@ class FootprintMonitor {
   /// \param tolerance_m2  how much of the footprint may lie outside (round-off).
   FootprintMonitor(std::shared_ptr<const topology::Topology> topology, double tolerance_m2 = 1e-3);
 
-  /// The vehicle holds `entity`, granted as `granted_as`, a step of its current route.
-  void hold(topology::EntityIndex entity, HeldStep granted_as);
+  /// The vehicle holds `entity`, granted as `granted_as`, a step of its current route
+  /// (`leftover`: of an earlier route, behind the vehicle whatever its step).
+  void hold(topology::EntityIndex entity, HeldStep granted_as, bool leftover = false);
   void drop(topology::EntityIndex entity);
   /// Marks every held entity a leftover of an earlier route (a new route begins): behind
   /// the vehicle whatever its step.

@@ -147,6 +147,16 @@ class LogicalAgent {
   /// hold until then): what was left in a partition that did not answer stays.
   /// \return false only when stopping before the topology agents answered.
   bool take_over();
+  /// Makes what an earlier life left this life's: the entities it holds become leftovers
+  /// (released once the footprint leaves them), and its routes are cancelled but for those
+  /// (in `partitions`; empty: every partition).
+  void adopt_leftovers(const Holdings& left, const std::vector<std::string>& partitions);
+  /// The rest of take_over, for the partitions whose owner did not answer it: tried at most
+  /// once a second while one of them has a live owner. What the earlier life left there
+  /// (the hold of a station in a partition whose topology agent restarted from its
+  /// journal, say) is adopted as take_over does, but for this life's own routes.
+  /// \return whether `partition` (when given) is known now.
+  bool take_over_late(const std::string& partition = {});
   /// Whether commands this life did not give (an earlier life's moves) still run on the
   /// RAN, or the vehicle still moves after them: they end on what that life allocated,
   /// which this life holds, so they are let run (a cancel would leave the vehicle part-way
@@ -327,6 +337,12 @@ class LogicalAgent {
   Activity activity_ = Activity::idle;
   TimeNs idle_since_ = 0;
   std::optional<TimeNs> error_since_;
+  /// Partitions that did not say at take_over what an earlier life left there.
+  std::vector<std::string> unknown_partitions_;
+  /// The routes this life asked for while unknown_partitions_ is not empty (not the
+  /// earlier life's: take_over_late leaves them be).
+  std::set<topology::RouteId> own_routes_;
+  std::chrono::steady_clock::time_point next_late_take_over_{};
   std::multiset<std::pair<topology::RouteId, DurationNs>> own_shift_echoes_;
   std::uint64_t command_counter_ = 0;
   std::uint64_t seen_events_ = 0;

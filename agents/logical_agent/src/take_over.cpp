@@ -94,27 +94,72 @@ bool LogicalAgent::take_over() {
     return true;
   }
   if (!holdings->unanswered.empty()) {
-    // Never seen or silent: what an earlier life left there stays (a hold of the vertex
-    // must not wait for it).
+    // Never seen or silent: what an earlier life left there is asked again once they have a
+    // live owner (take_over_late); a hold of the vertex must not wait for them.
     spdlog::error("partition(s) {} did not say within {} s what an earlier life of '{}' left there", 
                   fmt::join(holdings->unanswered, ", "), kTakeOverPatience.count(), vehicle_id());
+    unknown_partitions_ = holdings->unanswered;
   }
-  if (holdings->held.empty() && holdings->routes.empty()) return true;
+  adopt_leftovers(*holdings, {});
+  return true;
+}
+
+void LogicalAgent::adopt_leftovers(const Holdings& left, const std::vector<std::string>& partitions) {
+  if (left.held.empty() && left.routes.empty()) return;
   std::vector<std::string> held_ids;
-  for (const auto& [entity, step] : holdings->held) {
-    monitor_.hold(entity, step);
+  for (const auto& [entity, step] : left.held) {
+    monitor_.hold(entity, step, true);
     held_ids.push_back(topology_->id(entity));
   }
-  monitor_.forget_steps();  // leftovers: released once the footprint leaves them
   spdlog::warn("taking over from an earlier life of '{}': it holds [{}] and left {} route(s) reserved, now cancelled",
-               vehicle_id(), fmt::join(held_ids, ", "), holdings->routes.size());
-  for (const auto route : holdings->routes) {
-    if (auto cancelled = services_->cancel_route(vehicle_id(), route, monitor_.held_steps_of(route));
+               vehicle_id(), fmt::join(held_ids, ", "), left.routes.size());
+  for (const auto route : left.routes) {
+    if (auto cancelled = services_->cancel_route(vehicle_id(), route, monitor_.held_steps_of(route), partitions);
         !cancelled) {
       spdlog::warn("route {} of an earlier life not cancelled everywhere: {}", route, cancelled.error().message);
     }
   }
-  return true;
+}
+
+bool LogicalAgent::take_over_late(const std::string& partition) {
+  const auto known = [&] {
+    return partition.empty() ||
+           std::find(unknown_partitions_.begin(), unknown_partitions_.end(), partition) == unknown_partitions_.end();
+  };
+  const auto now = std::chrono::steady_clock::now();
+  if (unknown_partitions_.empty() || now < next_late_take_over_) return known();
+  next_late_take_over_ = now + std::chrono::seconds(1);
+  std::vector<std::string> reachable;
+  for (const auto& unknown : unknown_partitions_) {
+    if (services_->owner_of_partition(unknown)) reachable.push_back(unknown);
+  }
+  if (reachable.empty()) return known();
+  auto holdings = services_->holdings(vehicle_id(), now + options_.call_timeout, reachable);
+  if (!holdings) {
+    spdlog::warn("what an earlier life of '{}' left in partition(s) {} is still unknown: {}", vehicle_id(),
+                 fmt::join(reachable, ", "), holdings.error().message);
+    return known();
+  }
+  std::vector<std::string> answered;
+  for (const auto& partition : reachable) {
+    if (std::find(holdings->unanswered.begin(), holdings->unanswered.end(), partition) != holdings->unanswered.end()) {
+      continue;
+    }
+    answered.push_back(partition);
+    std::erase(unknown_partitions_, partition);
+  }
+  Holdings left;
+  for (const auto& [entity, step] : holdings->held) {
+    if (!own_routes_.contains(step.route) && !monitor_.holds(entity)) left.held.emplace_back(entity, step);
+  }
+  for (const auto route : holdings->routes) {
+    if (!own_routes_.contains(route)) left.routes.push_back(route);
+  }
+  spdlog::info("partition(s) {} answered what an earlier life of '{}' left there", fmt::join(answered, ", "),
+               vehicle_id());
+  adopt_leftovers(left, answered);
+  if (unknown_partitions_.empty()) own_routes_.clear();
+  return known();
 }
 
 bool LogicalAgent::earlier_commands_running(const ran::VehicleStatus& status) {

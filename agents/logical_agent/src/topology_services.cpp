@@ -297,9 +297,10 @@ std::vector<std::string> TopologyServices::partitions_touched(const std::vector<
   return {touched.begin(), touched.end()};
 }
 
-Result<Holdings> TopologyServices::holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up) {
+Result<Holdings> TopologyServices::holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up,
+                                            const std::vector<std::string>& partitions) {
   Holdings out;
-  for (const auto& partition : topology_->partitions()) {
+  for (const auto& partition : partitions.empty() ? topology_->partitions() : partitions) {
     auto reply = retry<msg::HoldingsReply>([&]() -> Result<msg::HoldingsReply> {
       auto owner = owner_of_partition(partition);
       if (!owner) return unexpected(owner.error());

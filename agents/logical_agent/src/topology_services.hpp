@@ -87,11 +87,12 @@ class TopologyServices {
   /// How many (route, partition) cancels are still due (see cancel_route).
   std::size_t cancels_due() const;
 
-  /// What `agent` has at the owners of every partition, each asked until it answers or
-  /// `give_up` has passed (then it is listed as unanswered). Entities the topology does not
-  /// know are left out (with a warning).
+  /// What `agent` has at the owners of `partitions` (empty: every partition), each asked
+  /// until it answers or `give_up` has passed (then it is listed as unanswered). Entities
+  /// the topology does not know are left out (with a warning).
   /// \return them, or the first other error (unavailable once stopping).
-  Result<Holdings> holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up);
+  Result<Holdings> holdings(const std::string& agent, std::chrono::steady_clock::time_point give_up,
+                            const std::vector<std::string>& partitions = {});
 
   /// The live topology agent owning `entity`. \return its id, or unavailable.
   Result<std::string> owner_of(topology::EntityIndex entity) const;
