@@ -790,7 +790,7 @@ TEST_F(FleetTest, ARanRestartedMidLoadFailsTheOrderInsteadOfLeavingItWaitingForE
   const auto pallet = wait_order("pallet");
   ASSERT_TRUE(pallet.has_value()) << "the order loading when the RAN restarted did not end";
   EXPECT_EQ(pallet->state(), msg::ORDER_FAILED);
-  EXPECT_NE(pallet->failure().find("is no longer reported by the RAN"), std::string::npos) << pallet->failure();
+  EXPECT_NE(pallet->failure().find("is no longer reported by the RAN, which restarted"), std::string::npos) << pallet->failure();
   const auto home = wait_order("home");
   ASSERT_TRUE(home.has_value()) << "the order queued behind it did not end";
   EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();

@@ -54,6 +54,12 @@ std::optional<ran::VehicleStatus> LogicalAgent::latest_status() {
   return status_;
 }
 
+std::optional<ran::VehicleStatus> LogicalAgent::recent_standing_status() {
+  std::lock_guard lock(mutex_);
+  if (std::chrono::steady_clock::now() - status_received_ > kRanSilence || !fresh_and_standing(0)) return std::nullopt;
+  return status_;
+}
+
 void LogicalAgent::run() {
   if (!take_over()) return;
   idle_since_ = clock_.now();
@@ -196,10 +202,14 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
   } else {
     spdlog::debug("cannot hold '{}' yet: {}", topology_->id(vertex), why);
   }
-  bool action_pending = false;  // the restored order's: the vehicle stays where it operates
+  bool action_pending = false;  // the restored order's, while the RAN runs it: the vehicle stays
   {
     std::lock_guard lock(mutex_);
-    action_pending = adopted_command_.has_value();
+    if (adopted_command_ && status_) {
+      action_pending = std::any_of(status_->commands.begin(), status_->commands.end(), [&](const auto& command) {
+        return command.id == *adopted_command_ && !ran::is_terminal(command.state);
+      });
+    }
   }
   if (clock_.now() >= clear_way_at_ && !action_pending) {
     clear_way_at_ = clock_.now() + kClearWayRetry;
@@ -262,6 +272,7 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
     // planned to leave: the route asked for starts on that vertex now. Reserved for a
     // retry's pause and call at least, whatever the clock's factor.
     keep_standing_reserved(*vertex_, 2 * options_.delay_threshold + clock_.to_sim(2 * kRoutePause));
+    take_over_late();  // what an earlier life left in a partition that is back may block this route
     topology::RouteId id = 0;
     while (id == 0) id = route_ids_();
     if (!unknown_partitions_.empty()) own_routes_.insert(id);
@@ -326,7 +337,11 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
       // A topology agent did not answer the routing agent: part of the route may be
       // reserved under this id (a commit whose reply was lost), so it is cancelled before
       // asking again under a new one.
-      if (nobody_answered(status.error())) cancel_route_quietly(id);
+      if (nobody_answered(status.error())) {
+        cancel_route_quietly(id);
+      } else {
+        own_routes_.erase(id);  // refused: nothing of it is reserved anywhere
+      }
       const bool blocked = failure == "no_window" || failure == "locked" || failure == "conflict" ||
                            nobody_answered(status.error());
       if (!blocked || clock_.now() >= give_up) {
@@ -813,10 +828,11 @@ Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activ
   if (verdict->rejected()) {
     return fail(ErrorCode::not_permitted, "the RAN rejected action '" + action.name + "': " + verdict->code + " " + verdict->reason);
   }
-  return await_action(action.id, action.name, false);
+  return await_action(action.id, action.name, std::nullopt);
 }
 
-Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name, bool listed) {
+Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name,
+                                  std::optional<std::uint64_t> listed_in) {
   for (;;) {
     if (!wait_event()) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     bool replan = false;
@@ -838,16 +854,18 @@ Status LogicalAgent::await_action(const ran::CommandId& command, const std::stri
                                               ended->code + " " + ended->reason);
     }
     if (status) {
-      // A command stays listed until it ends: a status after one that listed it, without it
-      // and without its end, comes from a RAN that forgot it (restarted).
+      // A RAN lists a command until it ends, and its end is kept in ended_commands_ as its
+      // status arrives. A status without it whose sequence went back below one that listed
+      // it comes from a RAN that started again (a sink counts from 1) and forgot it.
       const bool listed_now = std::any_of(status->commands.begin(), status->commands.end(),
                                           [&](const ran::CommandProgress& progress) { return progress.id == command; });
-      if (listed && !listed_now) {
+      if (listed_now) {
+        listed_in = status->sequence;
+      } else if (listed_in && status->sequence < *listed_in) {
         return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command +
-                                                "') is no longer reported by the RAN (it restarted?): whether it "
+                                                "') is no longer reported by the RAN, which restarted: whether it "
                                                 "was done is unknown (check the vehicle)");
       }
-      listed = listed || listed_now;
       if (auto error = check_errors(*status)) {
         if (auto cancelled = ran_->cancel(command, options_.call_timeout); !cancelled) {
           spdlog::warn("cancel of action '{}' not delivered: {}", name, cancelled.error().message);

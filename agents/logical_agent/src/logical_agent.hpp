@@ -137,6 +137,8 @@ class LogicalAgent {
   /// Waits for an event or the tick. \return false when stopping.
   bool wait_event();
   std::optional<ran::VehicleStatus> latest_status();
+  /// The latest status when it is recent and shows the vehicle still, else nullopt.
+  std::optional<ran::VehicleStatus> recent_standing_status();
   // ---- taking over from an earlier life (take_over.cpp) ----
   /// Once, before anything else: asks the topology agents what an earlier life of this
   /// agent (one that crashed or was killed) left there. What it holds becomes this life's
@@ -144,7 +146,7 @@ class LogicalAgent {
   /// its hold and releases the rest once the footprint leaves it); every route it left is
   /// cancelled but for those allocations, so that nobody waits behind a route no one drives.
   /// Waits a few seconds at most for the topology agents (the vehicle is not protected by a
-  /// hold until then): what was left in a partition that did not answer stays.
+  /// hold until then): a partition that did not answer is left to take_over_late.
   /// \return false only when stopping before the topology agents answered.
   bool take_over();
   /// Makes what an earlier life left this life's: the entities it holds become leftovers
@@ -213,11 +215,12 @@ class LogicalAgent {
   /// (its command is recorded first, OrderBook::action_commanded). \return success or why
   /// it failed.
   Status operate(const ran::ActionCommand& action, Activity activity, bool for_order = false);
-  /// Waits for the end of action `command` (named `name` in messages) on the RAN; `listed`:
-  /// a status has listed it already. \return success when it finished, otherwise why not
-  /// (it failed or was cancelled, a RAN error, or a status after one that listed it no
-  /// longer does: the RAN forgot it).
-  Status await_action(const ran::CommandId& command, const std::string& name, bool listed);
+  /// Waits for the end of action `command` (named `name` in messages) on the RAN;
+  /// `listed_in`: the sequence of a status that listed it already. \return success when it
+  /// finished, otherwise why not (it failed or was cancelled, a RAN error, or the RAN
+  /// restarted, its sequence going back, and no longer lists it: it forgot it).
+  Status await_action(const ran::CommandId& command, const std::string& name,
+                      std::optional<std::uint64_t> listed_in);
   /// The running order was restored with its operation at `destination` commanded as
   /// `command` by an earlier life: waits for that command's outcome. \return success when
   /// it finished; why not when it failed, or when the RAN does not report it (it restarted

@@ -177,7 +177,7 @@ Status OrderJournal::update(const Order& order) {
   Connection& c = *connection_;
   return c.db.transaction("storing order '" + order.name + "'", [&]() -> Status {
     if (Status ok = c.store(order); !ok) return ok;
-    if (!!is_open(order.state)) return {};
+    if (is_open(order.state)) return {};
     return c.db.run(c.forget_ended, {static_cast<std::int64_t>(c.ended_kept)}, "forget the oldest ended orders");
   });
 }

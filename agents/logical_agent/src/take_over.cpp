@@ -16,6 +16,9 @@ namespace {
 /// How long (real time) the start waits for the topology agents to say what an earlier
 /// life left: the vehicle is not protected by a hold of its vertex until then.
 constexpr std::chrono::seconds kTakeOverPatience{5};
+/// take_over_late: how long one try waits for answers, and the pause between tries.
+constexpr std::chrono::milliseconds kLateTakeOverTry{1000};
+constexpr std::chrono::seconds kLateTakeOverPause{1};
 }  // namespace
 
 void LogicalAgent::restore_orders(std::vector<Order> orders) {
@@ -61,20 +64,21 @@ Status LogicalAgent::resume_action(const ran::CommandId& command, const Destinat
       fmt::format("action '{}' at '{}' (RAN command '{}')", destination.operation, destination.location_id, command);
   const auto action = operation_action(destination);
   set_activity(action && action->kind == ran::ActionKind::charge ? Activity::charging : Activity::operating);
-  bool reported = false;
+  std::optional<std::uint64_t> listed_in;
   if (const auto status = latest_status()) {
-    reported = std::any_of(status->commands.begin(), status->commands.end(),
-                           [&](const ran::CommandProgress& progress) { return progress.id == command; });
+    const bool listed = std::any_of(status->commands.begin(), status->commands.end(),
+                                    [&](const ran::CommandProgress& progress) { return progress.id == command; });
+    if (listed) listed_in = status->sequence;
   }
   Status outcome;
-  if (!reported) {
+  if (!listed_in) {
     outcome = fail(ErrorCode::unavailable,
                    "the logical agent restarted while " + what +
                        " was under way, and the RAN does not report that command: whether it was done is unknown "
                        "(check the vehicle, then send the rest of the order again)");
   } else {
     spdlog::info("restored order: waiting for the outcome of {}, commanded by an earlier life", what);
-    outcome = await_action(command, destination.operation, true);
+    outcome = await_action(command, destination.operation, listed_in);
   }
   std::lock_guard lock(mutex_);
   adopted_command_.reset();
@@ -95,7 +99,7 @@ bool LogicalAgent::take_over() {
   }
   if (!holdings->unanswered.empty()) {
     // Never seen or silent: what an earlier life left there is asked again once they have a
-    // live owner (take_over_late); a hold of the vertex must not wait for them.
+    // live owner (take_over_late); a hold of a vertex in another partition does not wait.
     spdlog::error("partition(s) {} did not say within {} s what an earlier life of '{}' left there", 
                   fmt::join(holdings->unanswered, ", "), kTakeOverPatience.count(), vehicle_id());
     unknown_partitions_ = holdings->unanswered;
@@ -128,13 +132,16 @@ bool LogicalAgent::take_over_late(const std::string& partition) {
   };
   const auto now = std::chrono::steady_clock::now();
   if (unknown_partitions_.empty() || now < next_late_take_over_) return known();
-  next_late_take_over_ = now + std::chrono::seconds(1);
+  next_late_take_over_ = now + kLateTakeOverPause;
   std::vector<std::string> reachable;
   for (const auto& unknown : unknown_partitions_) {
     if (services_->owner_of_partition(unknown)) reachable.push_back(unknown);
   }
   if (reachable.empty()) return known();
-  auto holdings = services_->holdings(vehicle_id(), now + options_.call_timeout, reachable);
+  // One short try: an owner that seems live but does not answer (just crashed) must not
+  // keep the executor from its vehicle; the pause counts from the end of the try.
+  auto holdings = services_->holdings(vehicle_id(), now + kLateTakeOverTry, reachable);
+  next_late_take_over_ = std::chrono::steady_clock::now() + kLateTakeOverPause;
   if (!holdings) {
     spdlog::warn("what an earlier life of '{}' left in partition(s) {} is still unknown: {}", vehicle_id(),
                  fmt::join(reachable, ", "), holdings.error().message);
@@ -155,9 +162,15 @@ bool LogicalAgent::take_over_late(const std::string& partition) {
   for (const auto route : holdings->routes) {
     if (!own_routes_.contains(route)) left.routes.push_back(route);
   }
+  if (answered.empty()) return known();
   spdlog::info("partition(s) {} answered what an earlier life of '{}' left there", fmt::join(answered, ", "),
                vehicle_id());
   adopt_leftovers(left, answered);
+  if (!left.held.empty()) {
+    // Leftovers go once the footprint leaves them; a vehicle that stands (parked, say)
+    // would otherwise keep them until it next drives.
+    if (const auto status = recent_standing_status()) release_passed(*status);
+  }
   if (unknown_partitions_.empty()) own_routes_.clear();
   return known();
 }
