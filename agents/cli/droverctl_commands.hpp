@@ -28,6 +28,9 @@ void add_timeline_command(CLI::App& app, CommandContext& context);
 /// gone left behind.
 void add_release_command(CLI::App& app, CommandContext& context);
 
+/// `droverctl orders`: the orders the logical agents know, with their progress;
+/// agents/cli/orders_command.cpp.
+void add_orders_command(CLI::App& app, CommandContext& context);
 /// `droverctl vehicles`: what every vehicle is doing, from its logical agent's state;
 /// `droverctl alarms`: follows the operator alarms as they are raised.
 void add_vehicles_command(CLI::App& app, CommandContext& context);

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   add_timeline_command(app, context);
   add_order_command(app, context);
   add_vehicles_command(app, context);
+  add_orders_command(app, context);
   add_alarms_command(app, context);
   add_route_command(app, context);
 

@@ -19,6 +19,7 @@
 #include "agents/cli/agent_discovery.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
+#include "agents/cli/table.hpp"
 #include "drover/dds/agent_directory.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/logical_agent/messages.hpp"
@@ -70,26 +71,14 @@ std::string battery_text(double state_of_charge) {
   return out.str();
 }
 
-void print_table(const std::map<std::string, msg::VehicleState>& states) {
-  const std::vector<std::string> header{"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY"};
+void print_vehicles(const std::map<std::string, msg::VehicleState>& states) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& [vehicle, state] : states) {
     rows.push_back({vehicle, std::string(logical_agent::activity_name(state.state())), state.vertex().empty() ? "-" : state.vertex(),
                     state.order().empty() ? "-" : state.order(), std::to_string(state.queued_orders()),
                     state.moving() ? "yes" : "no", battery_text(state.state_of_charge())});
   }
-  std::vector<std::size_t> widths(header.size());
-  for (std::size_t i = 0; i < header.size(); ++i) widths[i] = header[i].size();
-  for (const auto& row : rows) {
-    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], row[i].size());
-  }
-  const auto print_row = [&](const std::vector<std::string>& row) {
-    for (std::size_t i = 0; i < row.size(); ++i) {
-      std::cout << row[i] << (i + 1 < row.size() ? std::string(widths[i] - row[i].size() + 2, ' ') : "\n");
-    }
-  };
-  print_row(header);
-  for (const auto& row : rows) print_row(row);
+  print_table(std::cout, {"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY"}, rows);
 }
 
 void print_json(const std::map<std::string, msg::VehicleState>& states) {
@@ -148,7 +137,7 @@ int run_vehicles(const VehiclesArguments& arguments) {
   if (arguments.json) {
     print_json(states);
   } else {
-    print_table(states);
+    print_vehicles(states);
   }
   return kExitOk;
 }

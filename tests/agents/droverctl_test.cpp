@@ -177,6 +177,17 @@ TEST_F(DroverctlTest, VehiclesExitsWithCode3WhenNoLogicalAgentAnswers) {
   EXPECT_NE(err.find("no logical agent answered on domain 43 within 0.5 s"), std::string::npos) << err;
 }
 
+TEST_F(DroverctlTest, OrdersExitsWithCode3WhenNoLogicalAgentAnswersAndRefusesBadOptions) {
+  std::string out, err;
+  auto status = run_droverctl({"orders", "--domain", "43", "--vehicle", "V9", "--timeout", "0.5"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 3);
+  EXPECT_NE(err.find("no logical agent of vehicle 'V9' answered on domain 43 within 0.5 s"), std::string::npos) << err;
+  status = run_droverctl({"orders", "--domain", "43", "--timeout", "soon"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2) << err;
+}
+
 TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm) {
   constexpr std::uint32_t kDomain = 44;
   auto agent = make_participant(kDomain, "V1");

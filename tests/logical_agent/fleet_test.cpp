@@ -747,6 +747,19 @@ TEST_F(FleetTest, ALogicalAgentRestartedFromItsOrderJournalAwaitsTheLoadItComman
   const auto home = wait_order("home");
   ASSERT_TRUE(home.has_value()) << "the order queued at the crash did not end";
   EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
+  // What an operator lists: both orders, ended, from the agent's next life.
+  std::string out, err;
+  ASSERT_EQ(droverctl(fleet, "orders", {"orders", "--vehicle", "V1", "--json", "--domain", std::to_string(kDomain)},
+                      out, err),
+            0)
+      << err;
+  const auto listed = nlohmann::json::parse(out);
+  ASSERT_EQ(listed.size(), 2u) << out;
+  EXPECT_EQ(listed[1]["order"], "pallet") << out;
+  EXPECT_EQ(listed[1]["state"], "finished") << out;
+  EXPECT_EQ(listed[1]["destination"], 2) << out;
+  EXPECT_EQ(listed[0]["order"], "home") << out;
+  EXPECT_EQ(listed[0]["state"], "finished") << out;
 
   std::lock_guard lock(seen_.mutex);
   EXPECT_EQ(seen_.latest["V1"].load, ran::LoadState::empty) << "unloaded at right-4";

@@ -18,6 +18,13 @@ inline std::string_view activity_name(msg::VehicleActivity activity) {
   return index < kNames.size() ? kNames[index] : "unknown";
 }
 
+/// "queued", "running", "finished", "failed", "withdrawn".
+inline std::string_view order_state_name(msg::OrderState state) {
+  static constexpr std::array<std::string_view, 5> kNames{"queued", "running", "finished", "failed", "withdrawn"};
+  const auto index = static_cast<std::size_t>(state);
+  return index < kNames.size() ? kNames[index] : "unknown";
+}
+
 inline constexpr std::array<std::string_view, 4> kSeverityNames{"info", "warning", "error", "critical"};
 
 /// "info", "warning", "error", "critical".
