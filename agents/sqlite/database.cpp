@@ -135,12 +135,24 @@ Status Database::run(const Statement& statement, std::initializer_list<Value> va
   return {};
 }
 
+namespace {
+
+/// `statement` stepped to its first row: true on a row, false when it has none.
+Result<bool> on_first_row(const Database& db, const Statement& statement, const std::string& what) {
+  const int rc = sqlite3_step(statement.get());
+  if (rc == SQLITE_DONE) return false;
+  if (rc != SQLITE_ROW) return unexpected(db.error(rc, what));
+  return true;
+}
+
+}  // namespace
+
 Result<std::optional<std::string>> Database::first_text(const char* sql, const std::string& what) {
   auto statement = prepare(sql, what);
   if (!statement) return unexpected(std::move(statement).error());
-  const int rc = sqlite3_step(statement->get());
-  if (rc == SQLITE_DONE) return std::optional<std::string>();
-  if (rc != SQLITE_ROW) return unexpected(error(rc, what));
+  const auto row = on_first_row(*this, *statement, what);
+  if (!row) return unexpected(row.error());
+  if (!*row) return std::optional<std::string>();
   const auto* text = sqlite3_column_text(statement->get(), 0);
   return std::optional<std::string>(text ? reinterpret_cast<const char*>(text) : "");
 }
@@ -148,9 +160,9 @@ Result<std::optional<std::string>> Database::first_text(const char* sql, const s
 Result<std::optional<std::int64_t>> Database::first_integer(const char* sql, const std::string& what) {
   auto statement = prepare(sql, what);
   if (!statement) return unexpected(std::move(statement).error());
-  const int rc = sqlite3_step(statement->get());
-  if (rc == SQLITE_DONE) return std::optional<std::int64_t>();
-  if (rc != SQLITE_ROW) return unexpected(error(rc, what));
+  const auto row = on_first_row(*this, *statement, what);
+  if (!row) return unexpected(row.error());
+  if (!*row) return std::optional<std::int64_t>();
   if (sqlite3_column_type(statement->get(), 0) != SQLITE_INTEGER) {
     return unexpected(content_error(what + ": not an integer"));
   }
