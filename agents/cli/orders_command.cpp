@@ -3,6 +3,7 @@
 // remember), from the progress they publish (drover/logical/order_progress, kept for late
 // joiners). Exit 3 when no logical agent is heard within the timeout.
 
+#include <algorithm>
 #include <iostream>
 #include <map>
 #include <memory>

@@ -206,9 +206,8 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
   {
     std::lock_guard lock(mutex_);
     if (adopted_command_ && status_) {
-      action_pending = std::any_of(status_->commands.begin(), status_->commands.end(), [&](const auto& command) {
-        return command.id == *adopted_command_ && !ran::is_terminal(command.state);
-      });
+      const auto* progress = status_->find_command(*adopted_command_);
+      action_pending = progress != nullptr && !ran::is_terminal(progress->state);
     }
   }
   if (clock_.now() >= clear_way_at_ && !action_pending) {
@@ -857,9 +856,7 @@ Status LogicalAgent::await_action(const ran::CommandId& command, const std::stri
       // A RAN lists a command until it ends, and its end is kept in ended_commands_ as its
       // status arrives. A status without it whose sequence went back below one that listed
       // it comes from a RAN that started again (a sink counts from 1) and forgot it.
-      const bool listed_now = std::any_of(status->commands.begin(), status->commands.end(),
-                                          [&](const ran::CommandProgress& progress) { return progress.id == command; });
-      if (listed_now) {
+      if (status->find_command(command) != nullptr) {
         listed_in = status->sequence;
       } else if (listed_in && status->sequence < *listed_in) {
         return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command +

@@ -65,10 +65,8 @@ Status LogicalAgent::resume_action(const ran::CommandId& command, const Destinat
   const auto action = operation_action(destination);
   set_activity(action && action->kind == ran::ActionKind::charge ? Activity::charging : Activity::operating);
   std::optional<std::uint64_t> listed_in;
-  if (const auto status = latest_status()) {
-    const bool listed = std::any_of(status->commands.begin(), status->commands.end(),
-                                    [&](const ran::CommandProgress& progress) { return progress.id == command; });
-    if (listed) listed_in = status->sequence;
+  if (const auto status = latest_status(); status && status->find_command(command) != nullptr) {
+    listed_in = status->sequence;
   }
   Status outcome;
   if (!listed_in) {
@@ -155,6 +153,7 @@ bool LogicalAgent::take_over_late(const std::string& partition) {
     answered.push_back(partition);
     std::erase(unknown_partitions_, partition);
   }
+  if (answered.empty()) return known();
   Holdings left;
   for (const auto& [entity, step] : holdings->held) {
     if (!own_routes_.contains(step.route) && !monitor_.holds(entity)) left.held.emplace_back(entity, step);
@@ -162,7 +161,6 @@ bool LogicalAgent::take_over_late(const std::string& partition) {
   for (const auto route : holdings->routes) {
     if (!own_routes_.contains(route)) left.routes.push_back(route);
   }
-  if (answered.empty()) return known();
   spdlog::info("partition(s) {} answered what an earlier life of '{}' left there", fmt::join(answered, ", "),
                vehicle_id());
   adopt_leftovers(left, answered);
