@@ -82,9 +82,9 @@ TEST(OrderBook, ValidatesLocationsAgainstTheTopology) {
 TEST(OrderBook, RunsOrdersInArrivalOrderThroughEveryDestination) {
   const auto world = h_crossing();
   std::vector<std::string> seen;
-  OrderBook book([&](const Order& order) {
+  OrderBook book({.changed = [&](const Order& order) {
     seen.push_back(order.name + ":" + to_string(order.state) + ":" + std::to_string(order.destination));
-  });
+  }});
   auto first = make_order(*world, OrderSpec{"a", {{"left-4", "load", {}}, {"right-4", "unload", {}}}, {}});
   auto second = make_order(*world, OrderSpec{"b", {{"left-0", "park", {}}}, {}});
   ASSERT_TRUE(first && second);
@@ -116,9 +116,9 @@ TEST(OrderBook, RunsOrdersInArrivalOrderThroughEveryDestination) {
 TEST(OrderBook, WithdrawsAQueuedOrderAtOnceAndARunningOneWhenTheExecutorEndsIt) {
   const auto world = h_crossing();
   std::vector<std::string> seen;
-  OrderBook book([&](const Order& order) {
+  OrderBook book({.changed = [&](const Order& order) {
     seen.push_back(order.name + ":" + to_string(order.state) + ":" + order.failure);
-  });
+  }});
   for (const char* name : {"a", "b", "c"}) {
     auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}, {"right-4", "NOP", {}}}, {}});
     ASSERT_TRUE(order);
@@ -160,7 +160,8 @@ TEST(OrderBook, WithdrawsAQueuedOrderAtOnceAndARunningOneWhenTheExecutorEndsIt) 
 
 TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysValid) {
   const auto world = h_crossing();
-  OrderBook book(nullptr, 2);
+  std::vector<std::string> forgotten;
+  OrderBook book({.forgotten = [&](const std::string& name) { forgotten.push_back(name); }}, 2);
   const auto add = [&](const char* name) {
     auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}}, {}});
     ASSERT_TRUE(order);
@@ -176,6 +177,7 @@ TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysVali
   ASSERT_TRUE(book.withdraw("c", "not needed", 24));
   // Three ended (a, c, d), two kept: a, the oldest, is forgotten, b's pointer still holds.
   EXPECT_EQ(book.find("a"), nullptr);
+  EXPECT_EQ(forgotten, std::vector<std::string>{"a"}) << "what was published of it can go";
   EXPECT_EQ(book.current(), b);
   EXPECT_EQ(b->name, "b");
   ASSERT_NE(book.find("c"), nullptr);
@@ -186,6 +188,7 @@ TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysVali
   EXPECT_EQ(book.add(*again, 30).error().code, ErrorCode::conflict);
   EXPECT_FALSE(book.advance(31));  // b finished: b, c and d ended, b (the oldest) goes
   EXPECT_EQ(book.find("b"), nullptr);
+  EXPECT_EQ(forgotten, (std::vector<std::string>{"a", "b"}));
   EXPECT_NE(book.find("c"), nullptr);
   EXPECT_NE(book.find("d"), nullptr);
   EXPECT_EQ(book.start_next(32)->name, "a");
@@ -193,7 +196,11 @@ TEST(OrderBook, KeepsTheNewestEndedOrdersOnlyAndAPointerToTheRunningOneStaysVali
 
 TEST(OrderBook, AWithdrawnOrderForgottenAtOnceStillAnswersWithdrawn) {
   const auto world = h_crossing();
-  OrderBook book(nullptr, 0);  // keeps no ended order: the withdrawn one goes as it ends
+  std::vector<std::string> events;
+  // Keeps no ended order: the withdrawn one goes as it ends, after it was published.
+  OrderBook book({.changed = [&](const Order& order) { events.push_back("published " + order.name + ":" + to_string(order.state)); },
+                  .forgotten = [&](const std::string& name) { events.push_back("forgotten " + name); }},
+                 0);
   for (const char* name : {"a", "b"}) {
     auto order = make_order(*world, OrderSpec{name, {{"left-4", "NOP", {}}}, {}});
     ASSERT_TRUE(order);
@@ -201,6 +208,8 @@ TEST(OrderBook, AWithdrawnOrderForgottenAtOnceStillAnswersWithdrawn) {
   }
   EXPECT_EQ(book.withdraw("a", "not needed", 20).value(), OrderState::withdrawn);
   EXPECT_EQ(book.find("a"), nullptr);
+  EXPECT_EQ(events, (std::vector<std::string>{"published a:queued", "published b:queued", "published a:withdrawn",
+                                              "forgotten a"}));
   EXPECT_EQ(book.start_next(30)->name, "b");
 }
 
@@ -208,14 +217,14 @@ TEST(OrderBook, RecordsEveryChangeBeforePublishingAndARecordingFailureRefusesANe
   const auto world = h_crossing();
   std::vector<std::string> events;
   bool disk_full = false;
-  OrderBook book([&](const Order& order) { events.push_back("published " + order.name + ":" + to_string(order.state)); },
-                 OrderBook::kEndedKept, [&](const Order& order, bool added) -> Status {
-                   if (disk_full) return fail(ErrorCode::io, "disk full");
-                   events.push_back(std::string(added ? "added " : "recorded ") + order.name + ":" +
-                                    to_string(order.state) + ":" + std::to_string(order.destination) + ":" +
-                                    order.action_command.value_or("-") + ":" + order.withdrawal.value_or("-"));
-                   return {};
-                 });
+  OrderBook book({.changed = [&](const Order& order) { events.push_back("published " + order.name + ":" + to_string(order.state)); },
+                  .record = [&](const Order& order, bool added) -> Status {
+                    if (disk_full) return fail(ErrorCode::io, "disk full");
+                    events.push_back(std::string(added ? "added " : "recorded ") + order.name + ":" +
+                                     to_string(order.state) + ":" + std::to_string(order.destination) + ":" +
+                                     order.action_command.value_or("-") + ":" + order.withdrawal.value_or("-"));
+                    return {};
+                  }});
   auto a = make_order(*world, OrderSpec{"a", {{"left-4", "load", {}}, {"right-4", "unload", {}}}, {}});
   auto b = make_order(*world, OrderSpec{"b", {{"left-0", "NOP", {}}}, {}});
   ASSERT_TRUE(a && b);
@@ -246,11 +255,14 @@ TEST(OrderBook, RestoresWhatAnEarlierLifeStoredAndGoesOnFromThere) {
   const auto world = h_crossing();
   std::vector<std::string> published;
   std::size_t recorded = 0;
-  OrderBook book([&](const Order& order) { published.push_back(order.name + ":" + to_string(order.state)); }, 1,
-                 [&](const Order&, bool) -> Status {
-                   ++recorded;
-                   return {};
-                 });
+  std::size_t forgotten = 0;
+  OrderBook book({.changed = [&](const Order& order) { published.push_back(order.name + ":" + to_string(order.state)); },
+                  .record = [&](const Order&, bool) -> Status {
+                    ++recorded;
+                    return {};
+                  },
+                  .forgotten = [&](const std::string&) { ++forgotten; }},
+                 1);
   std::vector<Order> stored;
   for (const char* name : {"old", "older-still", "running", "queued"}) {
     auto order = make_order(*world, OrderSpec{name, {{"left-4", "load", {}}, {"right-4", "NOP", {}}}, {}});
@@ -263,8 +275,10 @@ TEST(OrderBook, RestoresWhatAnEarlierLifeStoredAndGoesOnFromThere) {
   stored[2].destination = 1;
   book.restore(stored);
   EXPECT_EQ(recorded, 0u) << "restored orders are stored already";
-  EXPECT_EQ(published, (std::vector<std::string>{"old:finished", "older-still:failed", "running:running", "queued:queued"}));
-  // One ended order kept: the oldest goes; names known stay refused.
+  // One ended order kept: the oldest is left out, never published (nothing to retire).
+  EXPECT_EQ(published, (std::vector<std::string>{"older-still:failed", "running:running", "queued:queued"}));
+  EXPECT_EQ(forgotten, 0u);
+  // Names known stay refused.
   EXPECT_EQ(book.find("old"), nullptr);
   ASSERT_NE(book.find("older-still"), nullptr);
   EXPECT_EQ(book.add(stored[3], 5).error().code, ErrorCode::conflict);

@@ -50,6 +50,17 @@ Status WriterCore::write(void* sample, eprosima::fastrtps::rtps::WriteParams& pa
   return {};
 }
 
+Status WriterCore::retire(void* sample) {
+  // The writer's QoS keeps autodispose_unregistered_instances (the default): unregistering
+  // disposes too, and Fast DDS drops the instance's samples once every reader acknowledged.
+  const ReturnCode_t code = writer_->unregister_instance(sample, fdds::HANDLE_NIL);
+  if (code == ReturnCode_t::RETCODE_OK) return {};
+  if (code == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET) {
+    return fail(ErrorCode::not_found, "no instance of that key was written on '" + topic_name_ + "'");
+  }
+  return fail(ErrorCode::io, "could not retire an instance on '" + topic_name_ + "'");
+}
+
 bool WriterCore::matched(const GuidPrefix_t& participant) const {
   std::lock_guard lock(mutex_);
   return matched_.contains(participant);

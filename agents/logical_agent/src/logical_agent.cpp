@@ -45,8 +45,9 @@ LogicalAgent::LogicalAgent(std::shared_ptr<const topology::Topology> topology, S
     : topology_(std::move(topology)),
       clock_(clock),
       options_(std::move(options)),
-      book_([this](const Order& order) { publish_progress(order); }, OrderBook::kEndedKept,
-            [this](const Order& order, bool added) { return record_order(order, added); }),
+      book_({.changed = [this](const Order& order) { publish_progress(order); },
+             .record = [this](const Order& order, bool added) { return record_order(order, added); },
+             .forgotten = [this](const std::string& name) { retire_progress(name); }}),
       journal_(std::move(journal)),
       monitor_(topology_),
       command_prefix_(std::to_string(SharedClock::unix_now())),
@@ -292,6 +293,14 @@ void LogicalAgent::publish_progress(const Order& order) {
                order.destinations.size(), order.failure.empty() ? "" : ": " + order.failure);
   if (auto written = progress_writer_->write(progress); !written) {
     spdlog::warn("order progress not published: {}", written.error().message);
+  }
+}
+
+void LogicalAgent::retire_progress(const std::string& name) {
+  msg::OrderProgress key;
+  key.order(name);
+  if (auto retired = progress_writer_->retire(key); !retired) {
+    spdlog::warn("progress of forgotten order '{}' not retired: {}", name, retired.error().message);
   }
 }
 

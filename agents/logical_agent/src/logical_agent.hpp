@@ -131,6 +131,9 @@ class LogicalAgent {
   void on_make_way(const msg::MakeWayRequest& request);
   void on_status(const ran::VehicleStatus& status);
   void publish_progress(const Order& order);
+  /// Ends the published progress of an order the book forgot: late joiners (droverctl
+  /// orders) no longer get it, and the writer's history does not grow with every order.
+  void retire_progress(const std::string& name);
 
   // ---- executor ----
   void run();

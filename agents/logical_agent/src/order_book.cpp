@@ -162,11 +162,11 @@ void OrderBook::end_withdrawn(TimeNs now) {
 
 void OrderBook::restore(std::vector<Order> orders) {
   for (Order& order : orders) {
+    if (!is_open(order.state)) ++ended_;
     orders_.push_back(std::move(order));
-    publish(orders_.back());
-    if (!is_open(orders_.back().state)) ++ended_;
   }
-  forget_oldest_ended();
+  forget_oldest_ended(false);
+  for (const Order& order : orders_) publish(order);
 }
 
 void OrderBook::publish_ended(const Order& order) {
@@ -175,11 +175,13 @@ void OrderBook::publish_ended(const Order& order) {
   forget_oldest_ended();
 }
 
-void OrderBook::forget_oldest_ended() {
+void OrderBook::forget_oldest_ended(bool published) {
   while (ended_ > ended_kept_ && !orders_.empty()) {
     if (is_open(orders_.front().state)) break;  // older ended ones wait behind it
+    const std::string name = std::move(orders_.front().name);
     orders_.pop_front();
     --ended_;
+    if (published && hooks_.forgotten) hooks_.forgotten(name);
   }
 }
 

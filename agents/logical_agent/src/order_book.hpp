@@ -85,17 +85,28 @@ class OrderBook {
   /// on, since the vehicle's work must not stop for a full disk: the recorder deals with
   /// it (a queued order withdrawn meanwhile may then run after a restart).
   using Recorder = std::function<Status(const Order&, bool added)>;
+  /// Called with the name of an ended order the book forgets (see ended_kept), once the
+  /// observer heard of it: what was published of it can go too.
+  using Forgetter = std::function<void(const std::string& name)>;
+  /// What the book tells of its changes; each may be empty.
+  struct Hooks {
+    Observer changed = {};
+    Recorder record = {};
+    Forgetter forgotten = {};
+  };
   /// How many ended orders are kept for lookups (name conflicts, late withdrawals) by default.
   static constexpr std::size_t kEndedKept = 1000;
+
   /// \param ended_kept  ended orders kept, the oldest forgotten first (an agent runs for
   ///                    months: its book must not grow with every order it ever ran); a
   ///                    forgotten order's name may be used again
-  explicit OrderBook(Observer observer, std::size_t ended_kept = kEndedKept, Recorder recorder = {})
-      : observer_(std::move(observer)), recorder_(std::move(recorder)), ended_kept_(ended_kept) {}
+  explicit OrderBook(Hooks hooks, std::size_t ended_kept = kEndedKept)
+      : hooks_(std::move(hooks)), ended_kept_(ended_kept) {}
 
   /// Fills an empty book with orders an earlier life of the agent stored, oldest first (at
   /// most one running), and tells the observer of each (not the recorder: they are stored).
-  /// The oldest ended ones beyond ended_kept are forgotten.
+  /// The oldest ended ones beyond ended_kept are left out first (unpublished, so the
+  /// forgetter is not told of them).
   void restore(std::vector<Order> orders);
 
   /// Queues `order` at `now`. \return its 1-based position among the unfinished orders,
@@ -136,10 +147,10 @@ class OrderBook {
  private:
   Order* running();
   void publish(const Order& order) const {
-    if (observer_) observer_(order);
+    if (hooks_.changed) hooks_.changed(order);
   }
   Status record(const Order& order, bool added = false) const {
-    return recorder_ ? recorder_(order, added) : Status{};
+    return hooks_.record ? hooks_.record(order, added) : Status{};
   }
   /// Records, then publishes, a change of a known order.
   void changed(const Order& order) const {
@@ -147,14 +158,13 @@ class OrderBook {
     publish(order);
   }
   /// Forgets the oldest ended orders beyond ended_kept_ (only from the front: pointers to
-  /// the others, current(), stay valid).
-  void forget_oldest_ended();
+  /// the others, current(), stay valid), telling the forgetter when `published`.
+  void forget_oldest_ended(bool published = true);
   /// Records and publishes `order`, which has just ended, then forgets the oldest ended
   /// orders beyond ended_kept_, `order` itself possibly (not to be read afterwards).
   void publish_ended(const Order& order);
 
-  Observer observer_;
-  Recorder recorder_;
+  Hooks hooks_;
   std::size_t ended_kept_;
   std::size_t ended_ = 0;     ///< ended orders in orders_
   std::deque<Order> orders_;  ///< in arrival order; ended ones stay for lookups (see ended_kept_)

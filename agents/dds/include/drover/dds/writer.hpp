@@ -33,6 +33,14 @@ class Writer {
   /// \return success, or io when Fast DDS could not write it.
   Status write(const T& sample) { return core_->write(const_cast<T*>(&sample)); }
 
+  /// Ends the instance whose key `key` carries (its other fields are not read): readers
+  /// see it disposed, late joiners no longer get it, and the writer frees its last value
+  /// once every reader acknowledged. A keyed state topic whose keys keep coming (orders,
+  /// say) must retire the ones it is done with, or its history grows for ever.
+  /// \return success, not_found when this writer never wrote the instance (or retired it
+  ///         already), or io when Fast DDS could not.
+  Status retire(const T& key) { return core_->retire(const_cast<T*>(&key)); }
+
   std::size_t matched_readers() const { return core_->matched_readers(); }
   /// Waits until at least `count` readers are matched. \return whether they are.
   bool wait_for_readers(std::size_t count, std::chrono::milliseconds timeout) const {

@@ -42,6 +42,10 @@ class WriterCore final : private eprosima::fastdds::dds::DataWriterListener {
   /// Writes one sample with write parameters; on success params.sample_identity() holds
   /// the identity Fast DDS gave the sample.
   Status write(void* sample, eprosima::fastrtps::rtps::WriteParams& params);
+  /// Disposes and unregisters the instance whose key `sample` carries (see Writer::retire).
+  /// \return success, or not_found when this writer never wrote that instance (or retired
+  ///         it already), or io when Fast DDS could not.
+  Status retire(void* sample);
 
   bool matched(const eprosima::fastrtps::rtps::GuidPrefix_t& participant) const;
   std::vector<eprosima::fastrtps::rtps::GuidPrefix_t> matched_participants() const;
