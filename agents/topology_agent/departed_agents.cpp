@@ -26,8 +26,15 @@ constexpr std::chrono::milliseconds kHoldingsTimeout{3000};
 constexpr std::chrono::milliseconds kDeparturesPeriod{200};
 }  // namespace
 
-Status TopologyAgent::watch_departures() {
-  if (options_.departed_after.count() <= 0) return {};
+Status TopologyAgent::watch_logical_agents() {
+  dds::AgentDirectoryOptions watch;
+  watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
+  if (options_.departed_after.count() <= 0) {
+    auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
+    if (!directory) return unexpected(directory.error());
+    directory_ = std::move(*directory);
+    return {};
+  }
   auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, logical_agent::kAlarmTopic,
                                                         dds::TopicQos::events());
   if (!alarms) return unexpected(alarms.error());
@@ -37,8 +44,6 @@ Status TopologyAgent::watch_departures() {
   if (!holdings) return unexpected(holdings.error());
   holdings_client_ = std::move(*holdings);
   owe_heartbeats();  // before the directory: its first word of an agent may come at once
-  dds::AgentDirectoryOptions watch;
-  watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
   auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
   if (!directory) return unexpected(directory.error());
   directory_ = std::move(*directory);
@@ -64,14 +69,21 @@ void TopologyAgent::owe_heartbeats() {
   }
 }
 
+bool TopologyAgent::heard_alive(const std::string& agent) {
+  std::lock_guard lock(departed_mutex_);
+  return alive_.contains(agent);
+}
+
 void TopologyAgent::on_agent_change(const dds::AgentRecord& record) {
   if (record.kind != "logical") return;
   std::lock_guard lock(departed_mutex_);
   if (record.alive) {
+    alive_.insert(record.id);
     if (departed_.erase(record.id) > 0) spdlog::info("logical agent '{}' is back", record.id);
     return;
   }
-  if (departed_.contains(record.id)) return;
+  alive_.erase(record.id);
+  if (options_.departed_after.count() <= 0 || departed_.contains(record.id)) return;
   spdlog::info("logical agent '{}' lost ({}): its reservations here go in {:.1f} s unless it comes back", record.id,
                record.lost_reason, std::chrono::duration<double>(options_.departed_after).count());
   departed_[record.id] = Departure{std::chrono::steady_clock::now() + options_.departed_after, record.lost_reason};

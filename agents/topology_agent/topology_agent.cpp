@@ -173,7 +173,7 @@ Status TopologyAgent::start() {
     if (!status) return status;
   }
 
-  if (auto watched = watch_departures(); !watched) return watched;
+  if (auto watched = watch_logical_agents(); !watched) return watched;
 
   dds::HeartbeatOptions beat;
   beat.kind = "topology";
@@ -384,6 +384,15 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
 }
 
 void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle reply) {
+  // An operator's release (droverctl release) checks this too, but with its own view of the
+  // heartbeats: a logical agent this partition hears alive releases what it holds itself,
+  // once its vehicle has left; released under it, another vehicle could drive in.
+  if (reply.requester() != request.agent() && heard_alive(request.agent())) {
+    return send_error(reply, Error{ErrorCode::conflict,
+                                   "'" + request.agent() + "' is alive (topology agent '" + agent_id() +
+                                       "' hears its heartbeat): it releases what it holds itself once its vehicle "
+                                       "has left (stop its logical agent first if the vehicle is gone)"});
+  }
   std::lock_guard lock(mutex_);
   if (request.shadows_only()) {
     const auto origin = known_entity(request.entity());

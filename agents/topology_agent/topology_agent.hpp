@@ -120,8 +120,12 @@ class TopologyAgent {
   void run_expiry();
 
   // ---- logical agents that went away (departed_agents.cpp) ----
-  /// Starts watching the logical agents' heartbeats (with departed_after > 0).
-  Status watch_departures();
+  /// Starts watching the logical agents' heartbeats: which are alive (heard_alive), and,
+  /// with departed_after > 0, the sweeps of those that went away.
+  Status watch_logical_agents();
+  /// Whether logical agent `agent`'s heartbeat is heard here now (false until the first
+  /// heartbeats came in after the start). Takes departed_mutex_: never call with mutex_ held.
+  bool heard_alive(const std::string& agent);
   /// Makes a sweep due departed_after from now for every agent with reservations here (a
   /// journal's), called off by its first heartbeat (on_agent_change).
   void owe_heartbeats();
@@ -221,6 +225,7 @@ class TopologyAgent {
     std::string why;
   };
   std::map<std::string, Departure> departed_;  ///< logical agent id -> its sweep
+  std::set<std::string> alive_;                ///< logical agents whose heartbeat is heard
   std::thread departed_thread_;
 
   // Servers last: destroyed first, so no handler runs while the rest goes away.

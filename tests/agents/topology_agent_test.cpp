@@ -1,5 +1,5 @@
 // The topology agent as a process (`drover topology-agent`): the test process is its
-// client over DDS. Domains 60, 66..68 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
+// client over DDS. Domains 60, 66..68, 70..78 and 105. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 
@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@
 #include "agents/topology_agent/topology_agent.hpp"
 #include "agents/logical_agent/src/topology_services.hpp"
 #include "agents/topology_agent/wire.hpp"
+#include "drover/dds/heartbeat_publisher.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
 #include "drover/topology/topology_file.hpp"
@@ -419,6 +421,52 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderHoldingsShowItAnd
     }
     return false;
   }));
+}
+
+// Only a logical agent that is gone loses an allocation to someone else's release (an
+// operator's droverctl release): one whose heartbeat the topology agent hears releases what
+// it holds itself, whatever the operator's tool believes.
+TEST_F(TopologyAgentTest, WhatALiveLogicalAgentHoldsIsReleasedOnlyByItself) {
+  constexpr std::uint32_t kDomain = 105;
+  start_agent(kDomain, {"--departed-after", "0"});  // no sweep: only the heartbeats count
+  connect(kDomain);
+  reserve("v1", 1, {{"b", {1000, 2000}}});
+  ASSERT_TRUE(allocate("v1", "b", false).granted());
+  auto v1 = make_participant(kDomain, "v1");
+  ASSERT_NE(v1, nullptr);
+  dds::HeartbeatOptions beat;
+  beat.kind = "logical";
+  beat.owns = {"v1"};
+  auto heartbeat = dds::HeartbeatPublisher::create(*v1, SharedClock::wall(), beat);
+  ASSERT_TRUE(heartbeat.has_value()) << heartbeat.error().message;
+
+  // Once the topology agent hears v1, nobody else's release of v1's allocations is taken:
+  // a (harmless) release of an entity v1 does not hold says when that is.
+  const auto refused_as_alive = [](const msg::StatusReply& reply) {
+    return reply.error().code() == msg::ERROR_CONFLICT &&
+           reply.error().message().find("'v1' is alive") != std::string::npos;
+  };
+  const auto give_up = std::chrono::steady_clock::now() + kDiscoveryTimeout;
+  while (!refused_as_alive(release("v1", "a")) && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_TRUE(refused_as_alive(release("v1", "a"))) << "the topology agent never heard v1";
+  const auto refused = release("v1", "b");
+  EXPECT_TRUE(refused_as_alive(refused)) << refused.error().message();
+  EXPECT_EQ(timeline("b").holder(), "v1");
+
+  // v1 goes away: then an operator may clear what it left.
+  heartbeat->reset();
+  v1.reset();
+  const auto released = [&] { return release("v1", "b").error().code() == msg::ERROR_NONE; };
+  const auto later = std::chrono::steady_clock::now() + kDiscoveryTimeout;
+  bool done = released();
+  while (!done && std::chrono::steady_clock::now() < later) {
+    std::this_thread::sleep_for(100ms);
+    done = released();
+  }
+  EXPECT_TRUE(done) << "v1 gone, its allocation is still refused to others";
+  EXPECT_TRUE(wait_until([&] { return timelines_["b"].holder().empty(); }));
 }
 
 // A lock in force keeps a vehicle off the entity however its request came: a request queued
