@@ -18,6 +18,9 @@ void add_route_command(CLI::App& app, CommandContext& context);
 /// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent;
 /// `droverctl order withdraw VEHICLE ORDER`: withdraws one.
 void add_order_command(CLI::App& app, CommandContext& context);
+/// `droverctl pause VEHICLE`, `droverctl resume VEHICLE`: an operator stops a vehicle at the
+/// next vertex and lets it go on; agents/cli/pause_command.cpp.
+void add_pause_command(CLI::App& app, CommandContext& context);
 
 /// `droverctl lock ENTITY --from T --until T --reason TEXT`, `droverctl unlock LOCK_ID`,
 /// `droverctl timeline ENTITY`: the topology agents' locks and timelines.

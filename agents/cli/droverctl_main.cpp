@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   add_release_command(app, context);
   add_timeline_command(app, context);
   add_order_command(app, context);
+  add_pause_command(app, context);
   add_vehicles_command(app, context);
   add_orders_command(app, context);
   add_alarms_command(app, context);

@@ -71,14 +71,27 @@ std::string battery_text(double state_of_charge) {
   return out.str();
 }
 
+/// The state column: the activity, or "pausing" while a paused vehicle still drives its
+/// last moves.
+std::string state_text(const msg::VehicleState& state) {
+  if (state.paused() && state.state() != msg::VEHICLE_PAUSED) return "pausing";
+  return std::string(logical_agent::activity_name(state.state()));
+}
+
+/// The paused column: "-", or the pause's reason ("yes" without one).
+std::string paused_text(const msg::VehicleState& state) {
+  if (!state.paused()) return "-";
+  return state.pause_reason().empty() ? "yes" : state.pause_reason();
+}
+
 void print_vehicles(const std::map<std::string, msg::VehicleState>& states) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& [vehicle, state] : states) {
-    rows.push_back({vehicle, std::string(logical_agent::activity_name(state.state())), state.vertex().empty() ? "-" : state.vertex(),
+    rows.push_back({vehicle, state_text(state), state.vertex().empty() ? "-" : state.vertex(),
                     state.order().empty() ? "-" : state.order(), std::to_string(state.queued_orders()),
-                    state.moving() ? "yes" : "no", battery_text(state.state_of_charge())});
+                    state.moving() ? "yes" : "no", battery_text(state.state_of_charge()), paused_text(state)});
   }
-  print_table(std::cout, {"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY"}, rows);
+  print_table(std::cout, {"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY", "PAUSED"}, rows);
 }
 
 void print_json(const std::map<std::string, msg::VehicleState>& states) {
@@ -92,6 +105,8 @@ void print_json(const std::map<std::string, msg::VehicleState>& states) {
                    {"queued_orders", state.queued_orders()},
                    {"moving", state.moving()},
                    {"state_of_charge", state.state_of_charge()},
+                   {"paused", state.paused()},
+                   {"pause_reason", state.pause_reason()},
                    {"time_ns", state.time().ns()}});
   }
   std::cout << out.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";

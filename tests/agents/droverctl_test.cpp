@@ -142,14 +142,18 @@ TEST_F(DroverctlTest, VehiclesShowsWhatEveryVehicleIsDoing) {
   constexpr std::uint32_t kDomain = 42;
   FakeLogicalAgent v1(kDomain, vehicle_state("V1", msg::VEHICLE_DRIVING, "aisle-3", "o-17", 0.8, true));
   FakeLogicalAgent v2(kDomain, vehicle_state("V2", msg::VEHICLE_CHARGING, "charger-1", "", 0.15, false));
-  ASSERT_TRUE(v1.states && v2.states);
+  auto pausing = vehicle_state("V3", msg::VEHICLE_DRIVING, "aisle-4", "o-18", 0.5, true);
+  pausing.paused(true);
+  pausing.pause_reason("aisle blocked");
+  FakeLogicalAgent v3(kDomain, pausing);
+  ASSERT_TRUE(v1.states && v2.states && v3.states);
 
   std::string out, err;
   auto status = run_droverctl({"vehicles", "--domain", std::to_string(kDomain), "--json", "--timeout", "30"}, out, err);
   ASSERT_TRUE(status.has_value());
   ASSERT_EQ(status->code, 0) << err;
   const auto listed = nlohmann::json::parse(out);
-  ASSERT_EQ(listed.size(), 2u) << out;
+  ASSERT_EQ(listed.size(), 3u) << out;
   EXPECT_EQ(listed[0]["vehicle"], "V1");
   EXPECT_EQ(listed[0]["state"], "driving");
   EXPECT_EQ(listed[0]["vertex"], "aisle-3");
@@ -160,6 +164,10 @@ TEST_F(DroverctlTest, VehiclesShowsWhatEveryVehicleIsDoing) {
   EXPECT_EQ(listed[1]["vehicle"], "V2");
   EXPECT_EQ(listed[1]["state"], "charging");
   EXPECT_EQ(listed[1]["order"], "");
+  EXPECT_EQ(listed[1]["paused"], false);
+  EXPECT_EQ(listed[2]["state"], "driving");
+  EXPECT_EQ(listed[2]["paused"], true);
+  EXPECT_EQ(listed[2]["pause_reason"], "aisle blocked");
 
   status = run_droverctl({"vehicles", "--domain", std::to_string(kDomain), "--timeout", "30"}, out, err);
   ASSERT_TRUE(status.has_value());
@@ -167,6 +175,25 @@ TEST_F(DroverctlTest, VehiclesShowsWhatEveryVehicleIsDoing) {
   EXPECT_NE(out.find("VEHICLE"), std::string::npos) << out;
   EXPECT_NE(out.find("charging  charger-1"), std::string::npos) << out;
   EXPECT_NE(out.find("15 %"), std::string::npos) << out;
+  // Still driving its last moves, paused: the table says so, with the reason.
+  EXPECT_NE(out.find("pausing   aisle-4"), std::string::npos) << out;
+  EXPECT_NE(out.find("50 %     aisle blocked"), std::string::npos) << out;
+}
+
+TEST_F(DroverctlTest, PauseAndResumeExitWithCode3WhenNoLogicalAgentAnswersAndRefuseBadOptions) {
+  std::string out, err;
+  for (const char* command : {"pause", "resume"}) {
+    auto status = run_droverctl({command, "V9", "--domain", "43", "--timeout", "0.5"}, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 3) << command << ": " << err;
+    EXPECT_NE(err.find("vehicle 'V9'"), std::string::npos) << err;
+    status = run_droverctl({command, "--domain", "43"}, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 2) << command << " without a vehicle: " << err;
+  }
+  auto status = run_droverctl({"pause", "V9", "--wait", "-1", "--domain", "43"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2) << err;
 }
 
 TEST_F(DroverctlTest, VehiclesExitsWithCode3WhenNoLogicalAgentAnswers) {

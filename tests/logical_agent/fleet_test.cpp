@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 45..49, 69, 83..93 and 99..103. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 45..49, 69, 83..93, 99..103 and 106. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -904,6 +904,99 @@ TEST_F(FleetTest, ALogicalAgentRestartedWhileAPartitionIsDownTakesOverWhatItLeft
     if (violation.find(" while ") != std::string::npos) ADD_FAILURE() << violation;
   }
   EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();
+}
+
+TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesOnWhenResumed) {
+  constexpr std::uint32_t kDomain = 106;
+  Fleet fleet(kDomain, "pause");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  std::mutex states_mutex;
+  std::condition_variable states_changed;
+  std::optional<msg::VehicleState> state;
+  auto states = dds::Reader<msg::VehicleState>::create(*participant_, logical_agent::kVehicleStateTopic,
+                                                       [&](const msg::VehicleState& sample) {
+                                                         std::lock_guard lock(states_mutex);
+                                                         state = sample;
+                                                         states_changed.notify_all();
+                                                       });
+  ASSERT_TRUE(states.has_value());
+  const auto wait_state = [&](const std::function<bool(const msg::VehicleState&)>& condition) {
+    std::unique_lock lock(states_mutex);
+    return states_changed.wait_for(lock, 60s, [&] { return state && condition(*state); });
+  };
+  fleet.start_vehicle("V1", "left-0", {},
+                      {"--park-after", "-1", "--charge-below", "0", "--db", (fleet.dir() / "V1.db").string()});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "trip", {{"right-4", "NOP"}}), "");
+  ASSERT_EQ(send_order("V1", "back", {{"left-0", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed > 0; }, 60s))
+      << "V1 never drove";
+
+  // Paused while driving: it drives the moves it was given and stands on a vertex.
+  const std::string domain = std::to_string(kDomain);
+  std::string out, err;
+  ASSERT_EQ(droverctl(fleet, "pause", {"pause", "V1", "--reason", "aisle blocked", "--wait", "60", "--domain", domain},
+                      out, err),
+            0)
+      << out << err;
+  EXPECT_NE(out.find("vehicle 'V1' stands paused"), std::string::npos) << out;
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed == 0.0; }, 60s));
+  std::string paused_at;
+  ran::Pose pose;
+  {
+    std::lock_guard lock(seen_.mutex);
+    pose = seen_.latest["V1"].pose;
+    for (topology::EntityIndex v = 0; v < world_->vertex_count(); ++v) {
+      const auto& position = world_->vertex(v).position;
+      if (std::hypot(pose.x - position.x(), pose.y - position.y()) < 0.05) paused_at = world_->id(v);
+    }
+    ASSERT_FALSE(paused_at.empty()) << "V1 stopped off its vertices, at (" << pose.x << ", " << pose.y << ")";
+    EXPECT_NE(paused_at, "right-4") << "V1 drove on to its destination";
+    EXPECT_EQ(seen_.holders[paused_at], "V1") << "V1 does not hold the vertex it stands on";
+    EXPECT_EQ(seen_.orders["trip"].state(), msg::ORDER_RUNNING) << "a pause is no failure";
+    EXPECT_EQ(seen_.orders["back"].state(), msg::ORDER_QUEUED);
+  }
+
+  // Its logical agent restarts (the journal keeps the pause): it holds its vertex again and
+  // stays paused, its orders where they were.
+  const TimeNs restarted = clock_->now();
+  ASSERT_NO_FATAL_FAILURE(fleet.crash_and_restart("V1"));
+  ASSERT_TRUE(wait_state([&](const msg::VehicleState& s) { return s.time().ns() > restarted && s.state() == msg::VEHICLE_PAUSED; }))
+      << "V1's next life is not paused";
+  ASSERT_EQ(droverctl(fleet, "vehicles", {"vehicles", "--json", "--domain", domain}, out, err), 0) << err;
+  const auto listed = nlohmann::json::parse(out);
+  ASSERT_EQ(listed.size(), 1u) << out;
+  EXPECT_EQ(listed[0]["state"], "paused") << out;
+  EXPECT_EQ(listed[0]["paused"], true) << out;
+  EXPECT_EQ(listed[0]["pause_reason"], "aisle blocked") << out;
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders[paused_at] == "V1"; }, 60s)) << "V1's next life holds nothing";
+  {
+    std::lock_guard lock(seen_.mutex);
+    const auto& now = seen_.latest["V1"].pose;
+    EXPECT_LT(std::hypot(now.x - pose.x, now.y - pose.y), 0.05) << "V1 moved while paused";
+    EXPECT_EQ(seen_.orders["trip"].state(), msg::ORDER_RUNNING);
+    EXPECT_EQ(seen_.orders["back"].state(), msg::ORDER_QUEUED);
+  }
+
+  // Resumed: the orders run on.
+  ASSERT_EQ(droverctl(fleet, "resume", {"resume", "V1", "--domain", domain}, out, err), 0) << out << err;
+  EXPECT_NE(out.find("vehicle 'V1' resumed"), std::string::npos) << out;
+  for (const char* name : {"trip", "back"}) {
+    const auto ended = wait_order(name);
+    ASSERT_TRUE(ended.has_value()) << "order " << name << " did not end";
+    EXPECT_EQ(ended->state(), msg::ORDER_FINISHED) << name << ": " << ended->failure();
+  }
+  EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }));
+  // A vehicle no logical agent serves: nobody answers.
+  EXPECT_EQ(droverctl(fleet, "pause-nobody", {"pause", "V9", "--timeout", "1", "--domain", domain}, out, err), 3)
+      << out << err;
+  states->reset();
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
+  for (const auto& alarm : seen_.alarms) {
+    if (alarm.severity() >= msg::ALARM_WARNING) ADD_FAILURE() << "alarm: " << alarm.text();
+  }
 }
 
 TEST_F(FleetTest, ALogicalAgentGoneForGoodLosesItsRouteButKeepsWhatItsVehicleOccupiesTillTheToldOperatorReleasesIt) {

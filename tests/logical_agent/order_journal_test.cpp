@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -189,6 +190,37 @@ TEST_F(OrderJournalTest, AnotherVehiclesJournalAnotherKindOfFileAndOneInUseAreRe
   ASSERT_FALSE(nowhere);
   EXPECT_EQ(nowhere.error().code, ErrorCode::io);
   EXPECT_NE(nowhere.error().message.find("directory does not exist"), std::string::npos) << nowhere.error().message;
+}
+
+TEST_F(OrderJournalTest, AnOperatorsPauseOutlivesTheAgentUntilItIsResumed) {
+  {
+    auto journal = OrderJournal::open(file(), "V1");
+    ASSERT_TRUE(journal) << journal.error().message;
+    EXPECT_EQ(journal->load_pause().value(), std::nullopt) << "a new journal is not paused";
+    ASSERT_TRUE(journal->store_pause("aisle 4 blocked"));
+    ASSERT_TRUE(journal->store_pause("aisle 4 cleaned"));  // paused again: the newer reason
+  }
+  {
+    auto journal = OrderJournal::open(file(), "V1");
+    ASSERT_TRUE(journal) << journal.error().message;
+    EXPECT_EQ(journal->load_pause().value(), std::optional<std::string>("aisle 4 cleaned"));
+    ASSERT_TRUE(journal->store_pause(std::nullopt));
+    ASSERT_TRUE(journal->store_pause(std::nullopt)) << "resuming twice is no error";
+  }
+  {
+    auto journal = OrderJournal::open(file(), "V1");
+    ASSERT_TRUE(journal) << journal.error().message;
+    EXPECT_EQ(journal->load_pause().value(), std::nullopt);
+  }
+  ASSERT_NO_FATAL_FAILURE(poke(file(), "INSERT INTO meta (key, value) VALUES ('paused', 42)"));
+  auto journal = OrderJournal::open(file(), "V1");
+  ASSERT_TRUE(journal) << journal.error().message;
+  const auto damaged = journal->load_pause();
+  ASSERT_FALSE(damaged);
+  EXPECT_EQ(damaged.error().code, ErrorCode::parse);
+  EXPECT_NE(damaged.error().message.find("table meta, row 'paused': the reason is not text"), std::string::npos)
+      << damaged.error().message;
+  EXPECT_NE(damaged.error().message.find(file().string()), std::string::npos) << damaged.error().message;
 }
 
 TEST_F(OrderJournalTest, ADamagedRowIsRefusedNamingTableRowAndColumn) {

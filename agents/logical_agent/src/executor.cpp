@@ -75,6 +75,13 @@ void LogicalAgent::run() {
       }
       set_activity(Activity::idle);
     }
+    if (pause_requested() && !adopted_action_pending()) {
+      // Holding its vertex, it begins nothing: no order, charging, parking or making way.
+      set_activity(Activity::paused);
+      publish_vehicle_state(false);
+      wait_event();
+      continue;
+    }
     const auto status = latest_status();
     const bool battery_low = status && options_.charge_below > 0 &&
                              status->battery.state_of_charge < options_.charge_below && !status->battery.charging;
@@ -267,6 +274,8 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
   for (;;) {
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     if (for_order && order_withdrawn()) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
+    // Only the hold of the vertex it stands on is planned for a paused vehicle.
+    if (goal != *vertex_ && pause_requested()) return fail(ErrorCode::not_permitted, "the vehicle is paused");
     // Waiting here (a re-plan after a lock, say), the vehicle stands where its old route
     // planned to leave: the route asked for starts on that vertex now. Reserved for a
     // retry's pause and call at least, whatever the clock's factor.
@@ -439,6 +448,10 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
         // The vehicle stands on the vertex its last move reached: the rest of the route goes.
         abandon_route();
         return fail(ErrorCode::not_permitted, "the order is being withdrawn");
+      case FollowResult::paused:
+        // As for a withdrawal; the drive is asked for again once the vehicle is resumed.
+        abandon_route();
+        return fail(ErrorCode::not_permitted, "the vehicle is paused");
     }
   }
 }
@@ -503,8 +516,11 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
     // was given (at most the look-ahead) and stands on a vertex, never part-way along an
     // edge as a cancel would leave it.
     const bool withdrawn = drive_activity_ == Activity::driving && order_withdrawn();
-    if (replan || withdrawn) {
-      if (pending_moves_.empty()) return withdrawn ? FollowResult::withdrawn : FollowResult::replan;
+    const bool paused = !withdrawn && pause_requested();
+    if (replan || withdrawn || paused) {
+      if (pending_moves_.empty()) {
+        return withdrawn ? FollowResult::withdrawn : paused ? FollowResult::paused : FollowResult::replan;
+      }
     } else {
       // Allocation ahead, in route order, within the look-ahead.
       while (auto next = route_->next_to_allocate(route_->position_step(), options_.lookahead)) {
@@ -879,6 +895,16 @@ bool LogicalAgent::order_withdrawn() {
   return book_.withdrawal_pending();
 }
 
+bool LogicalAgent::pause_requested() {
+  std::lock_guard lock(mutex_);
+  return pause_.has_value();
+}
+
+bool LogicalAgent::adopted_action_pending() {
+  std::lock_guard lock(mutex_);
+  return adopted_command_.has_value();
+}
+
 void LogicalAgent::execute_order() {
   // A withdrawal ends the order between its steps: before a drive, after it (the operation
   // is skipped), or after an operation (which is completed, not cut short) when more
@@ -888,6 +914,13 @@ void LogicalAgent::execute_order() {
     if (!book_.withdrawal_pending()) return false;
     book_.end_withdrawn(clock_.now());
     spdlog::info("order '{}' withdrawn", name);
+    return true;
+  };
+  // A pause leaves the order running where it got to: the run loop holds the vertex the
+  // vehicle stands on and comes back here once it is resumed.
+  const auto paused_at = [this](const std::string& name) {
+    if (!pause_requested()) return false;
+    spdlog::info("order '{}' waits: the vehicle is paused", name);
     return true;
   };
   for (;;) {
@@ -908,11 +941,13 @@ void LogicalAgent::execute_order() {
     if (commanded) {
       done = resume_action(*commanded, destination);  // an operation under way is completed first
     } else {
-      if (end_if_withdrawn(name)) return;
+      if (end_if_withdrawn(name) || paused_at(name)) return;
       done = drive_to(destination.location, Activity::driving, options_.route_limit);
       if (end_if_withdrawn(name)) return;
+      if (!done && paused_at(name)) return;  // stopped on the way: the drive is asked for again
       if (done) {
         if (auto action = operation_action(destination)) {
+          if (paused_at(name)) return;  // not begun: the drive to here finds it arrived
           const bool charge = action->kind == ran::ActionKind::charge;
           if (charge && !action->parameters.count("target")) action->parameters["target"] = std::to_string(options_.charge_to);
           done = operate(*action, charge ? Activity::charging : Activity::operating, true);
@@ -972,6 +1007,7 @@ void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
   const bool charger = kind == topology::VertexKind::charger;
   const bool reached = drive_to_nearest(kind, true);
   idle_since_ = clock_.now();
+  if (pause_requested()) return;  // stopped by an operator, not failed: tried again once resumed
   if (!reached) {
     if (charger) charge_retry_at_ = clock_.now() + kChargeRetry;
     spdlog::warn("no {} vertex could be reached", charger ? "charger" : "parking");

@@ -65,17 +65,26 @@ Result<std::unique_ptr<LogicalAgent>> LogicalAgent::create(std::shared_ptr<const
   if (options.vehicle.id.empty()) options.vehicle.id = options.participant.agent_id;
   std::optional<OrderJournal> journal;
   std::vector<Order> stored;
+  std::optional<std::string> pause;
   if (!options.order_journal.empty()) {
     auto opened = OrderJournal::open(options.order_journal, options.participant.agent_id);
     if (!opened) return unexpected(std::move(opened).error());
     auto loaded = opened->load();
     if (!loaded) return unexpected(std::move(loaded).error());
+    auto paused = opened->load_pause();
+    if (!paused) return unexpected(std::move(paused).error());
+    pause = std::move(*paused);
     journal = std::move(*opened);
     stored = std::move(*loaded);
   }
   std::unique_ptr<LogicalAgent> agent(
       new LogicalAgent(std::move(topology), clock, std::move(options), std::move(journal)));
   agent->restored_ = std::move(stored);
+  agent->pause_ = std::move(pause);
+  if (agent->pause_) {
+    spdlog::warn("the vehicle stays paused, as an operator left it ({})",
+                 agent->pause_->empty() ? "no reason given" : *agent->pause_);
+  }
   if (auto started = agent->start(); !started) return unexpected(started.error());
   return agent;
 }
@@ -141,6 +150,13 @@ Status LogicalAgent::start() {
       });
   if (!withdraw) return unexpected(withdraw.error());
   withdraw_server_ = std::move(*withdraw);
+  auto pause = dds::ServiceServer<msg::VehiclePauseRequest, msg::StatusReply>::create(
+      *participant_, kServiceArea, kPauseService,
+      [this](const msg::VehiclePauseRequest& request, dds::ReplyHandle<msg::StatusReply> reply) {
+        on_pause(request, std::move(reply));
+      });
+  if (!pause) return unexpected(pause.error());
+  pause_server_ = std::move(*pause);
 
   executor_ = std::thread([this] { run(); });
   return {};
@@ -153,6 +169,7 @@ LogicalAgent::~LogicalAgent() {
   }
   wake_.notify_all();
   if (executor_.joinable()) executor_.join();
+  pause_server_.reset();
   withdraw_server_.reset();
   order_server_.reset();
   make_way_reader_.reset();
@@ -240,6 +257,38 @@ void LogicalAgent::on_withdraw(const msg::OrderWithdrawRequest& request,
                  *state == OrderState::withdrawn ? "withdrawn" : "being withdrawn",
                  request.reason().empty() ? "no reason given" : request.reason());
   }
+  if (auto sent = reply.send(std::move(answer)); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
+}
+
+void LogicalAgent::on_pause(const msg::VehiclePauseRequest& request, dds::ReplyHandle<msg::StatusReply> reply) {
+  const char* what = request.paused() ? "pause" : "resume";
+  Status outcome;
+  if (request.header().responder().empty()) {
+    // As for orders: every logical agent sees an unaddressed request.
+    outcome = fail(ErrorCode::invalid_argument, std::string(what) + ": header.responder must name the vehicle");
+  } else {
+    std::optional<std::string> next;
+    if (request.paused()) next = request.reason();
+    {
+      std::lock_guard lock(mutex_);
+      // Stored first: a pause the journal lost would end with a restart, unnoticed.
+      if (journal_) outcome = journal_->store_pause(next);
+      if (outcome) {
+        pause_ = std::move(next);
+        ++events_;
+      }
+    }
+    wake_.notify_all();
+  }
+  if (!outcome) {
+    spdlog::warn("{} refused: {}", what, outcome.error().message);
+  } else if (request.paused()) {
+    spdlog::info("paused by '{}' ({})", reply.requester(), request.reason().empty() ? "no reason given" : request.reason());
+  } else {
+    spdlog::info("resumed by '{}'", reply.requester());
+  }
+  msg::StatusReply answer;
+  if (!outcome) answer.error(dds::to_wire(outcome.error()));
   if (auto sent = reply.send(std::move(answer)); !sent) spdlog::warn("reply not sent: {}", sent.error().message);
 }
 
@@ -357,8 +406,8 @@ void LogicalAgent::set_activity(Activity activity) {
 
 void LogicalAgent::publish_vehicle_state(bool force) {
   static constexpr msg::VehicleActivity kWire[] = {
-      msg::VEHICLE_IDLE,    msg::VEHICLE_DRIVING, msg::VEHICLE_OPERATING, msg::VEHICLE_PARKING,
-      msg::VEHICLE_CHARGING, msg::VEHICLE_WAITING, msg::VEHICLE_ERROR};
+      msg::VEHICLE_IDLE,     msg::VEHICLE_DRIVING, msg::VEHICLE_OPERATING, msg::VEHICLE_PARKING,
+      msg::VEHICLE_CHARGING, msg::VEHICLE_WAITING, msg::VEHICLE_ERROR,     msg::VEHICLE_PAUSED};
   msg::VehicleState state;
   state.vehicle(vehicle_id());
   state.ran(options_.ran_agent.empty() ? ran::ran_agent_id(vehicle_id()) : options_.ran_agent);
@@ -368,6 +417,8 @@ void LogicalAgent::publish_vehicle_state(bool force) {
     std::lock_guard lock(mutex_);
     if (const Order* order = book_.current()) state.order(order->name);
     state.queued_orders(static_cast<std::uint32_t>(book_.queued_count()));
+    state.paused(pause_.has_value());
+    state.pause_reason(pause_.value_or(""));
     if (status_) {
       state.state_of_charge(status_->battery.state_of_charge);
       state.moving(!ran::standing_still(status_->linear_speed, status_->angular_speed));
@@ -376,7 +427,9 @@ void LogicalAgent::publish_vehicle_state(bool force) {
   const auto real_now = std::chrono::steady_clock::now();
   const bool changed = state.state() != last_published_.state() || state.vertex() != last_published_.vertex() ||
                        state.order() != last_published_.order() || state.moving() != last_published_.moving() ||
-                       state.queued_orders() != last_published_.queued_orders();
+                       state.queued_orders() != last_published_.queued_orders() ||
+                       state.paused() != last_published_.paused() ||
+                       state.pause_reason() != last_published_.pause_reason();
   if (!force && !changed && real_now - last_publication_ < std::chrono::seconds(1)) return;
   state.time().ns(clock_.now());
   last_published_ = state;

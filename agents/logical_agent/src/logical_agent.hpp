@@ -101,10 +101,10 @@ class LogicalAgent {
   const std::string& vehicle_id() const noexcept { return participant_->agent_id(); }
 
  private:
-  enum class Activity { idle, driving, operating, parking, charging, waiting, error };
-  /// How following a route ended (withdrawn: the running order is being withdrawn and the
-  /// vehicle stands where its commanded moves took it).
-  enum class FollowResult { arrived, replan, failed, withdrawn };
+  enum class Activity { idle, driving, operating, parking, charging, waiting, error, paused };
+  /// How following a route ended (withdrawn: the running order is being withdrawn, paused:
+  /// an operator paused the vehicle; either way it stands where its commanded moves took it).
+  enum class FollowResult { arrived, replan, failed, withdrawn, paused };
 
   LogicalAgent(std::shared_ptr<const topology::Topology> topology, SharedClock clock, LogicalAgentOptions options,
                std::optional<OrderJournal> journal);
@@ -127,6 +127,8 @@ class LogicalAgent {
   // ---- DDS callbacks (record and wake) ----
   void on_order(const msg::OrderRequest& request, dds::ReplyHandle<msg::OrderReply> reply);
   void on_withdraw(const msg::OrderWithdrawRequest& request, dds::ReplyHandle<msg::OrderWithdrawReply> reply);
+  /// An operator pauses or resumes the vehicle (stored in the journal first, if any).
+  void on_pause(const msg::VehiclePauseRequest& request, dds::ReplyHandle<msg::StatusReply> reply);
   void on_notice(const msg::ReservationNotice& notice);
   void on_make_way(const msg::MakeWayRequest& request);
   void on_status(const ran::VehicleStatus& status);
@@ -233,6 +235,12 @@ class LogicalAgent {
   void execute_order();
   /// Whether the running order is being withdrawn.
   bool order_withdrawn();
+  /// Whether an operator paused the vehicle: it then plans, allocates and begins nothing new
+  /// but the hold of the vertex it stands on (an action under way, or one an earlier life
+  /// commanded, is completed).
+  bool pause_requested();
+  /// Whether the action of a restored order, commanded by an earlier life, is still awaited.
+  bool adopted_action_pending();
   /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
   void go_to_service_vertex(topology::VertexKind kind);
   /// Drives to the nearest vertex of `kind` other than the one the vehicle stands on (or,
@@ -319,6 +327,9 @@ class LogicalAgent {
   bool journal_failing_ = false;  ///< the operator was told; until the journal is written again
   /// The orders an earlier life stored, from create() to start() (restore_orders).
   std::vector<Order> restored_;
+  /// Paused by an operator (the reason given), until resumed: the vehicle stops on a vertex
+  /// and begins nothing new (pause_requested).
+  std::optional<std::string> pause_;
   /// The latest request to make way for another vehicle.
   struct MakeWay {
     std::string requester;
@@ -390,6 +401,7 @@ class LogicalAgent {
   std::unique_ptr<dds::Reader<msg::MakeWayRequest>> make_way_reader_;
   std::unique_ptr<dds::ServiceServer<msg::OrderRequest, msg::OrderReply>> order_server_;
   std::unique_ptr<dds::ServiceServer<msg::OrderWithdrawRequest, msg::OrderWithdrawReply>> withdraw_server_;
+  std::unique_ptr<dds::ServiceServer<msg::VehiclePauseRequest, msg::StatusReply>> pause_server_;
   std::thread executor_;
 };
 

@@ -1,6 +1,6 @@
 // The logical agent's order journal; see order_journal.hpp. The schema:
 //   schema_version(version)   one row: kSchemaVersion
-//   meta(key, value)          vehicle
+//   meta(key, value)          vehicle; paused (the reason) while an operator paused it
 //   orders(seq, name, destinations, properties, state, destination, created_ns, started_ns,
 //          finished_ns, failure, withdrawal, action_command)
 // seq is the arrival order (never reused); destinations and properties are JSON text:
@@ -100,7 +100,7 @@ struct OrderJournal::Connection {
   sqlite::Database db;
   std::size_t ended_kept;
   // Declared after db: finalized before it closes.
-  sqlite::Statement forget_name, upsert, forget_ended;
+  sqlite::Statement forget_name, upsert, forget_ended, pause, resume;
 
   Connection(sqlite::Database database, std::size_t kept) : db(std::move(database)), ended_kept(kept) {}
 
@@ -114,6 +114,9 @@ struct OrderJournal::Connection {
          "state = excluded.state, destination = excluded.destination, created_ns = excluded.created_ns, "
          "started_ns = excluded.started_ns, finished_ns = excluded.finished_ns, failure = excluded.failure, "
          "withdrawal = excluded.withdrawal, action_command = excluded.action_command"},
+        {&pause,
+         "INSERT INTO meta (key, value) VALUES ('paused', ?) ON CONFLICT (key) DO UPDATE SET value = excluded.value"},
+        {&resume, "DELETE FROM meta WHERE key = 'paused'"},
         {&forget_ended,
          "DELETE FROM orders WHERE seq IN (SELECT seq FROM orders WHERE state IN ('finished', 'failed', "
          "'withdrawn') ORDER BY seq DESC LIMIT -1 OFFSET ?)"},
@@ -180,6 +183,21 @@ Status OrderJournal::update(const Order& order) {
     if (is_open(order.state)) return {};
     return c.db.run(c.forget_ended, {static_cast<std::int64_t>(c.ended_kept)}, "forget the oldest ended orders");
   });
+}
+
+Status OrderJournal::store_pause(const std::optional<std::string>& reason) {
+  Connection& c = *connection_;
+  if (!reason) return c.db.run(c.resume, {}, "store the resume");
+  return c.db.run(c.pause, {std::string_view(*reason)}, "store the pause");
+}
+
+Result<std::optional<std::string>> OrderJournal::load_pause() {
+  Connection& c = *connection_;
+  auto type = c.db.first_text("SELECT typeof(value) FROM meta WHERE key = 'paused'", "load the pause");
+  if (!type) return unexpected(std::move(type).error());
+  if (!*type) return std::optional<std::string>();
+  if (**type != "text") return unexpected(c.db.content_error("table meta, row 'paused': the reason is not text"));
+  return c.db.first_text("SELECT value FROM meta WHERE key = 'paused'", "load the pause");
 }
 
 Result<std::vector<Order>> OrderJournal::load() {

@@ -10,6 +10,8 @@
 #include <cstddef>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -57,6 +59,14 @@ class OrderJournal {
   ///         an unknown state, destinations that are not the JSON this journal writes, a
   ///         destination index out of range, or a second running order.
   Result<std::vector<Order>> load();
+
+  /// Stores that an operator paused the vehicle for `reason` (a pause that must outlive the
+  /// agent), or, with nullopt, that it was resumed; durable when it returns.
+  /// \return io or parse naming the file; then the stored pause is unchanged.
+  Status store_pause(const std::optional<std::string>& reason);
+  /// The stored pause's reason, nullopt when the vehicle is not paused.
+  /// \return parse naming the file for a reason that is not text.
+  Result<std::optional<std::string>> load_pause();
 
  private:
   struct Connection;

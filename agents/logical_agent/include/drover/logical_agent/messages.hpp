@@ -12,6 +12,7 @@ DROVER_DDS_MESSAGE(OrderRequest);
 DROVER_DDS_MESSAGE(OrderReply);
 DROVER_DDS_MESSAGE(OrderWithdrawRequest);
 DROVER_DDS_MESSAGE(OrderWithdrawReply);
+DROVER_DDS_MESSAGE(VehiclePauseRequest);
 DROVER_DDS_MESSAGE(OrderProgress);
 DROVER_DDS_MESSAGE(VehicleState);
 DROVER_DDS_MESSAGE(OperatorAlarm);

@@ -11,6 +11,9 @@ inline constexpr const char* kOrderService = "order";
 /// Service drover/logical/withdraw/{request,reply}: OrderWithdrawRequest / OrderWithdrawReply,
 /// addressed like an order.
 inline constexpr const char* kWithdrawService = "withdraw";
+/// Service drover/logical/pause/{request,reply}: VehiclePauseRequest / StatusReply,
+/// addressed like an order.
+inline constexpr const char* kPauseService = "pause";
 /// State topic of OrderProgress, keyed on the order name.
 inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progress";
 /// State topic of VehicleState, keyed on the vehicle id.

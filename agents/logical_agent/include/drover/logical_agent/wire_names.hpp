@@ -10,10 +10,10 @@
 
 namespace drover::logical_agent {
 
-/// "idle", "driving", "operating", "parking", "charging", "waiting", "error".
+/// "idle", "driving", "operating", "parking", "charging", "waiting", "error", "paused".
 inline std::string_view activity_name(msg::VehicleActivity activity) {
-  static constexpr std::array<std::string_view, 7> kNames{"idle",     "driving", "operating", "parking",
-                                                          "charging", "waiting", "error"};
+  static constexpr std::array<std::string_view, 8> kNames{"idle",     "driving", "operating", "parking",
+                                                          "charging", "waiting", "error",     "paused"};
   const auto index = static_cast<std::size_t>(activity);
   return index < kNames.size() ? kNames[index] : "unknown";
 }
