@@ -22,10 +22,10 @@
 #include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
+#include "agents/cli/logical_agent_call.hpp"
 #include "drover/common/clock.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
-#include "drover/dds/wire_error.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
 
@@ -139,18 +139,7 @@ class OrderSession {
                            const std::string& refused, int& exit_code) {
     exit_code = open(options, service, order, wait_seconds);
     if (exit_code != kExitOk) return std::nullopt;
-    auto reply = client_->call(request, options.timeout(), vehicle);
-    if (!reply) {
-      std::cerr << "error: vehicle '" << vehicle << "': " << reply.error().message << "\n";
-      exit_code = reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
-      return std::nullopt;
-    }
-    if (auto status = dds::from_wire(reply->error()); !status) {
-      std::cerr << "error: vehicle '" << vehicle << "' " << refused << ": " << status.error().message << "\n";
-      exit_code = kExitFailure;
-      return std::nullopt;
-    }
-    return std::move(*reply);
+    return call_logical_agent(*client_, options, vehicle, request, refused, exit_code);
   }
   /// Waits up to `wait_seconds` for `order` to end in state `expected`. \return kExitOk after
   /// printing "order 'x' <done>", or kExitFailure after printing "... <not_done> within S s"

@@ -17,9 +17,9 @@
 #include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
+#include "agents/cli/logical_agent_call.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
-#include "drover/dds/wire_error.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
 
@@ -38,7 +38,7 @@ class PausedWatch {
  public:
   explicit PausedWatch(std::string vehicle) : vehicle_(std::move(vehicle)) {}
   void on_state(const msg::VehicleState& state) {
-    if (state.vehicle() != vehicle_ || state.state() != msg::VEHICLE_PAUSED) return;
+    if (state.vehicle() != vehicle_ || !state.paused() || state.state() != msg::VEHICLE_PAUSED) return;
     std::lock_guard lock(mutex_);
     standing_ = true;
     changed_.notify_all();
@@ -82,15 +82,10 @@ int run_pause(const PauseArguments& arguments, bool pause) {
   msg::VehiclePauseRequest request;
   request.paused(pause);
   request.reason(arguments.reason);
-  const auto reply = (*client)->call(request, arguments.dds.timeout(), arguments.vehicle);
-  if (!reply) {
-    std::cerr << "error: vehicle '" << arguments.vehicle << "': " << reply.error().message << "\n";
-    return reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
-  }
-  if (auto status = dds::from_wire(reply->error()); !status) {
-    std::cerr << "error: vehicle '" << arguments.vehicle << "' was not " << (pause ? "paused" : "resumed") << ": "
-              << status.error().message << "\n";
-    return kExitFailure;
+  int code = kExitOk;
+  if (!call_logical_agent(**client, arguments.dds, arguments.vehicle, request,
+                          pause ? "was not paused" : "was not resumed", code)) {
+    return code;
   }
   if (!pause) {
     std::cout << "vehicle '" << arguments.vehicle << "' resumed\n";

@@ -74,7 +74,9 @@ std::string battery_text(double state_of_charge) {
 /// The state column: the activity, or "pausing" while a paused vehicle still drives its
 /// last moves.
 std::string state_text(const msg::VehicleState& state) {
-  if (state.paused() && state.state() != msg::VEHICLE_PAUSED) return "pausing";
+  const bool driving = state.state() == msg::VEHICLE_DRIVING || state.state() == msg::VEHICLE_PARKING ||
+                       state.state() == msg::VEHICLE_CHARGING;
+  if (state.paused() && driving && state.moving()) return "pausing";
   return std::string(logical_agent::activity_name(state.state()));
 }
 

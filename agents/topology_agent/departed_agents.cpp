@@ -27,27 +27,24 @@ constexpr std::chrono::milliseconds kDeparturesPeriod{200};
 }  // namespace
 
 Status TopologyAgent::watch_logical_agents() {
+  const bool sweeping = options_.departed_after.count() > 0;
+  if (sweeping) {
+    auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, logical_agent::kAlarmTopic,
+                                                          dds::TopicQos::events());
+    if (!alarms) return unexpected(alarms.error());
+    alarm_writer_ = std::move(*alarms);
+    auto holdings = dds::ServiceClient<msg::HoldingsRequest, msg::HoldingsReply>::create(*participant_,
+                                                                                         kServiceArea, "holdings");
+    if (!holdings) return unexpected(holdings.error());
+    holdings_client_ = std::move(*holdings);
+    owe_heartbeats();  // before the directory: its first word of an agent may come at once
+  }
   dds::AgentDirectoryOptions watch;
   watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };
-  if (options_.departed_after.count() <= 0) {
-    auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
-    if (!directory) return unexpected(directory.error());
-    directory_ = std::move(*directory);
-    return {};
-  }
-  auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, logical_agent::kAlarmTopic,
-                                                        dds::TopicQos::events());
-  if (!alarms) return unexpected(alarms.error());
-  alarm_writer_ = std::move(*alarms);
-  auto holdings = dds::ServiceClient<msg::HoldingsRequest, msg::HoldingsReply>::create(*participant_, kServiceArea,
-                                                                                       "holdings");
-  if (!holdings) return unexpected(holdings.error());
-  holdings_client_ = std::move(*holdings);
-  owe_heartbeats();  // before the directory: its first word of an agent may come at once
   auto directory = dds::AgentDirectory::create(*participant_, std::move(watch));
   if (!directory) return unexpected(directory.error());
   directory_ = std::move(*directory);
-  departed_thread_ = std::thread([this] { run_departures(); });  // after directory_: it reads it
+  if (sweeping) departed_thread_ = std::thread([this] { run_departures(); });  // after directory_: it reads it
   return {};
 }
 

@@ -95,8 +95,12 @@ TEST(TopicTest, ARetiredInstanceIsNoLongerGivenToLateJoiners) {
   ASSERT_TRUE(writer.has_value()) << writer.error().message;
   for (const char* entity : {"e1", "e2", "e3"}) ASSERT_TRUE((*writer)->write(timeline(entity, 1)).has_value());
   ASSERT_TRUE((*writer)->retire(timeline("e1", 0)).has_value()) << "only the key is read";
-  EXPECT_EQ((*writer)->retire(timeline("e1", 0)).error().code, ErrorCode::not_found) << "retired already";
-  EXPECT_EQ((*writer)->retire(timeline("e9", 0)).error().code, ErrorCode::not_found) << "never written";
+  const auto again = (*writer)->retire(timeline("e1", 0));
+  ASSERT_FALSE(again.has_value()) << "retired already";
+  EXPECT_EQ(again.error().code, ErrorCode::not_found);
+  const auto unknown = (*writer)->retire(timeline("e9", 0));
+  ASSERT_FALSE(unknown.has_value()) << "never written";
+  EXPECT_EQ(unknown.error().code, ErrorCode::not_found);
   // A retired key may be written again: a new instance.
   ASSERT_TRUE((*writer)->write(timeline("e4", 1)).has_value());
 

@@ -953,10 +953,11 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
     }
     ASSERT_FALSE(paused_at.empty()) << "V1 stopped off its vertices, at (" << pose.x << ", " << pose.y << ")";
     EXPECT_NE(paused_at, "right-4") << "V1 drove on to its destination";
-    EXPECT_EQ(seen_.holders[paused_at], "V1") << "V1 does not hold the vertex it stands on";
     EXPECT_EQ(seen_.orders["trip"].state(), msg::ORDER_RUNNING) << "a pause is no failure";
     EXPECT_EQ(seen_.orders["back"].state(), msg::ORDER_QUEUED);
   }
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders[paused_at] == "V1"; }, 60s))
+      << "V1 does not hold the vertex it stands on";
 
   // Its logical agent restarts (the journal keeps the pause): it holds its vertex again and
   // stays paused, its orders where they were.
@@ -979,15 +980,25 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
     EXPECT_EQ(seen_.orders["back"].state(), msg::ORDER_QUEUED);
   }
 
-  // Resumed: the orders run on.
+  // The running order withdrawn while the vehicle is paused: it ends at once (the vehicle
+  // stands).
+  ASSERT_EQ(droverctl(fleet, "withdraw", {"order", "withdraw", "V1", "trip", "--wait", "60", "--domain", domain}, out,
+                      err),
+            0)
+      << out << err;
+  // Resumed: the queued order runs.
   ASSERT_EQ(droverctl(fleet, "resume", {"resume", "V1", "--domain", domain}, out, err), 0) << out << err;
   EXPECT_NE(out.find("vehicle 'V1' resumed"), std::string::npos) << out;
-  for (const char* name : {"trip", "back"}) {
-    const auto ended = wait_order(name);
-    ASSERT_TRUE(ended.has_value()) << "order " << name << " did not end";
-    EXPECT_EQ(ended->state(), msg::ORDER_FINISHED) << name << ": " << ended->failure();
-  }
+  const auto back = wait_order("back");
+  ASSERT_TRUE(back.has_value()) << "order back did not end";
+  EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
   EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }));
+  // Paused and resumed while idle: idle again (ready for the next order), not paused.
+  ASSERT_EQ(droverctl(fleet, "pause-idle", {"pause", "V1", "--wait", "60", "--domain", domain}, out, err), 0)
+      << out << err;
+  ASSERT_EQ(droverctl(fleet, "resume-idle", {"resume", "V1", "--domain", domain}, out, err), 0) << out << err;
+  EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
+      << "V1 resumed with nothing to do is not idle";
   // A vehicle no logical agent serves: nobody answers.
   EXPECT_EQ(droverctl(fleet, "pause-nobody", {"pause", "V9", "--timeout", "1", "--domain", domain}, out, err), 3)
       << out << err;

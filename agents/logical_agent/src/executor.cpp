@@ -76,12 +76,15 @@ void LogicalAgent::run() {
       set_activity(Activity::idle);
     }
     if (pause_requested() && !adopted_action_pending()) {
-      // Holding its vertex, it begins nothing: no order, charging, parking or making way.
+      // Holding its vertex, it begins nothing: no order, charging, parking or making way. A
+      // withdrawal of the running order ends it now: the vehicle stands.
       set_activity(Activity::paused);
+      end_pending_withdrawal();
       publish_vehicle_state(false);
       wait_event();
       continue;
     }
+    if (activity_ == Activity::paused) set_activity(Activity::idle);  // resumed
     const auto status = latest_status();
     const bool battery_low = status && options_.charge_below > 0 &&
                              status->battery.state_of_charge < options_.charge_below && !status->battery.charging;
@@ -99,7 +102,7 @@ void LogicalAgent::run() {
     if (has_work) {
       {
         std::lock_guard lock(mutex_);
-        book_.start_next(clock_.now());
+        if (!pause_) book_.start_next(clock_.now());  // a pause that came meanwhile starts nothing
       }
       execute_order();
       set_activity(Activity::idle);
@@ -200,11 +203,13 @@ bool LogicalAgent::hold_position() {
 
 bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& why) {
   keep_standing_reserved(vertex, kStrandedReserve + clock_.to_sim(2 * kRoutePause));
+  const bool paused = pause_requested();
   if (!hold_alarm_raised_) {
     raise_alarm(msg::ALARM_WARNING,
                 fmt::format("vehicle '{}' cannot hold '{}' ({}): it keeps it reserved, so that the vehicles due "
-                            "there wait behind it, and tries to clear the way to a parking vertex",
-                            vehicle_id(), topology_->id(vertex), why));
+                            "there wait behind it, and {}",
+                            vehicle_id(), topology_->id(vertex), why,
+                            paused ? "stays there while it is paused" : "tries to clear the way to a parking vertex"));
     hold_alarm_raised_ = true;
   } else {
     spdlog::debug("cannot hold '{}' yet: {}", topology_->id(vertex), why);
@@ -217,7 +222,7 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
       action_pending = progress != nullptr && !ran::is_terminal(progress->state);
     }
   }
-  if (clock_.now() >= clear_way_at_ && !action_pending) {
+  if (clock_.now() >= clear_way_at_ && !action_pending && !paused) {
     clear_way_at_ = clock_.now() + kClearWayRetry;
     if (drive_to_nearest(topology::VertexKind::parking, false)) {
       spdlog::info("vehicle '{}' cleared the way: it holds '{}'", vehicle_id(), topology_->id(*vertex_));
@@ -225,7 +230,7 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
       return true;
     }
   }
-  set_activity(Activity::waiting);
+  set_activity(paused ? Activity::paused : Activity::waiting);
   pause_before_retry();
   return false;
 }
@@ -275,7 +280,10 @@ Result<RouteTracker> LogicalAgent::plan_route(topology::EntityIndex goal, Durati
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     if (for_order && order_withdrawn()) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
     // Only the hold of the vertex it stands on is planned for a paused vehicle.
-    if (goal != *vertex_ && pause_requested()) return fail(ErrorCode::not_permitted, "the vehicle is paused");
+    if (goal != *vertex_ && pause_requested()) {
+      stopped_for_pause_ = true;
+      return fail(ErrorCode::not_permitted, "the vehicle is paused");
+    }
     // Waiting here (a re-plan after a lock, say), the vehicle stands where its old route
     // planned to leave: the route asked for starts on that vertex now. Reserved for a
     // retry's pause and call at least, whatever the clock's factor.
@@ -430,7 +438,8 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
       return switched;
     }
     std::string failure;
-    switch (follow(failure)) {
+    const FollowResult result = follow(failure);
+    switch (result) {
       case FollowResult::arrived:
         vertex_ = goal;
         return {};
@@ -445,12 +454,12 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
         abandon_route();
         return fail(ErrorCode::unavailable, failure);
       case FollowResult::withdrawn:
-        // The vehicle stands on the vertex its last move reached: the rest of the route goes.
-        abandon_route();
-        return fail(ErrorCode::not_permitted, "the order is being withdrawn");
       case FollowResult::paused:
-        // As for a withdrawal; the drive is asked for again once the vehicle is resumed.
+        // The vehicle stands on the vertex its last move reached: the rest of the route goes
+        // (paused: the drive is asked for again once the vehicle is resumed).
         abandon_route();
+        if (result == FollowResult::withdrawn) return fail(ErrorCode::not_permitted, "the order is being withdrawn");
+        stopped_for_pause_ = true;
         return fail(ErrorCode::not_permitted, "the vehicle is paused");
     }
   }
@@ -905,22 +914,28 @@ bool LogicalAgent::adopted_action_pending() {
   return adopted_command_.has_value();
 }
 
+bool LogicalAgent::end_pending_withdrawal() {
+  std::lock_guard lock(mutex_);
+  if (!book_.withdrawal_pending()) return false;
+  spdlog::info("order '{}' withdrawn", book_.current()->name);
+  book_.end_withdrawn(clock_.now());
+  return true;
+}
+
 void LogicalAgent::execute_order() {
   // A withdrawal ends the order between its steps: before a drive, after it (the operation
   // is skipped), or after an operation (which is completed, not cut short) when more
   // destinations follow; a drive under way stops at the next vertex it can (drive_to).
-  const auto end_if_withdrawn = [this](const std::string& name) {
-    std::lock_guard lock(mutex_);
-    if (!book_.withdrawal_pending()) return false;
-    book_.end_withdrawn(clock_.now());
-    spdlog::info("order '{}' withdrawn", name);
-    return true;
-  };
   // A pause leaves the order running where it got to: the run loop holds the vertex the
   // vehicle stands on and comes back here once it is resumed.
   const auto paused_at = [this](const std::string& name) {
     if (!pause_requested()) return false;
     spdlog::info("order '{}' waits: the vehicle is paused", name);
+    return true;
+  };
+  const auto stopped_for_pause = [this](const std::string& name) {
+    if (!std::exchange(stopped_for_pause_, false)) return false;
+    spdlog::info("order '{}' waits: the vehicle was paused on the way", name);
     return true;
   };
   for (;;) {
@@ -941,10 +956,11 @@ void LogicalAgent::execute_order() {
     if (commanded) {
       done = resume_action(*commanded, destination);  // an operation under way is completed first
     } else {
-      if (end_if_withdrawn(name) || paused_at(name)) return;
+      if (end_pending_withdrawal() || paused_at(name)) return;
+      stopped_for_pause_ = false;
       done = drive_to(destination.location, Activity::driving, options_.route_limit);
-      if (end_if_withdrawn(name)) return;
-      if (!done && paused_at(name)) return;  // stopped on the way: the drive is asked for again
+      if (end_pending_withdrawal()) return;
+      if (!done && stopped_for_pause(name)) return;  // the drive is asked for again once resumed
       if (done) {
         if (auto action = operation_action(destination)) {
           if (paused_at(name)) return;  // not begun: the drive to here finds it arrived
@@ -954,7 +970,7 @@ void LogicalAgent::execute_order() {
         }
       }
     }
-    if (done && !last && end_if_withdrawn(name)) return;
+    if (done && !last && end_pending_withdrawal()) return;
     if (!done) {
       if (stopping_ && journal_) {
         // Stopped, not failed: the journal has it running (with its action, if commanded),
@@ -1005,9 +1021,10 @@ bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do
 
 void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
   const bool charger = kind == topology::VertexKind::charger;
+  stopped_for_pause_ = false;
   const bool reached = drive_to_nearest(kind, true);
   idle_since_ = clock_.now();
-  if (pause_requested()) return;  // stopped by an operator, not failed: tried again once resumed
+  if (std::exchange(stopped_for_pause_, false)) return;  // not failed: tried again once resumed
   if (!reached) {
     if (charger) charge_retry_at_ = clock_.now() + kChargeRetry;
     spdlog::warn("no {} vertex could be reached", charger ? "charger" : "parking");

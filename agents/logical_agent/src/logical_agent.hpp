@@ -241,6 +241,9 @@ class LogicalAgent {
   bool pause_requested();
   /// Whether the action of a restored order, commanded by an earlier life, is still awaited.
   bool adopted_action_pending();
+  /// Ends the running order as withdrawn when a withdrawal of it is pending (the vehicle
+  /// stands, or is between the order's steps). \return whether it did.
+  bool end_pending_withdrawal();
   /// Drives to the nearest vertex of `kind` that can be held; charges there for chargers.
   void go_to_service_vertex(topology::VertexKind kind);
   /// Drives to the nearest vertex of `kind` other than the one the vehicle stands on (or,
@@ -381,6 +384,9 @@ class LogicalAgent {
   std::optional<TimeNs> earlier_commands_since_;
   bool earlier_commands_cancelled_ = false;  ///< their cancel was sent (once)
   TimeNs clear_way_at_ = 0;         ///< when stranded_on tries to clear the way next
+  /// The last drive (or route asked for) stopped because the vehicle was paused, not failed;
+  /// cleared by whoever reads it.
+  bool stopped_for_pause_ = false;
   bool making_way_ = false;                          ///< driving aside: requests wait
   std::map<std::string, TimeNs> make_way_asked_;     ///< blocker -> when last asked
   std::string command_prefix_;
