@@ -996,6 +996,7 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   // Paused and resumed while idle: idle again (ready for the next order), not paused.
   ASSERT_EQ(droverctl(fleet, "pause-idle", {"pause", "V1", "--wait", "60", "--domain", domain}, out, err), 0)
       << out << err;
+  ASSERT_TRUE(wait_state([](const msg::VehicleState& s) { return s.paused() && s.state() == msg::VEHICLE_PAUSED; }));
   ASSERT_EQ(droverctl(fleet, "resume-idle", {"resume", "V1", "--domain", domain}, out, err), 0) << out << err;
   EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
       << "V1 resumed with nothing to do is not idle";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <utility>
 
 #include <boost/geometry.hpp>
 #include <fmt/format.h>
@@ -222,6 +223,7 @@ bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& 
       action_pending = progress != nullptr && !ran::is_terminal(progress->state);
     }
   }
+  if (paused) end_pending_withdrawal();  // the vehicle stands: as in the run loop's pause
   if (clock_.now() >= clear_way_at_ && !action_pending && !paused) {
     clear_way_at_ = clock_.now() + kClearWayRetry;
     if (drive_to_nearest(topology::VertexKind::parking, false)) {
@@ -1006,6 +1008,7 @@ bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do
     if (stopping_) break;
     spdlog::info("{}: trying '{}'", charger ? "going to charge" : "parking", topology_->id(candidate));
     auto route = plan_route(candidate, 0, false);
+    if (!route && stopped_for_pause_) return false;  // refused for the pause: so would every other be
     if (!route) {
       spdlog::info("no route to '{}' now: {}", topology_->id(candidate), route.error().message);
       continue;
@@ -1024,7 +1027,9 @@ void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
   stopped_for_pause_ = false;
   const bool reached = drive_to_nearest(kind, true);
   idle_since_ = clock_.now();
-  if (std::exchange(stopped_for_pause_, false)) return;  // not failed: tried again once resumed
+  // Stopped for the pause, not failed, or reached just as the pause came: nothing is begun
+  // (no charge), and it is tried again once the vehicle is resumed.
+  if (std::exchange(stopped_for_pause_, false) || pause_requested()) return;
   if (!reached) {
     if (charger) charge_retry_at_ = clock_.now() + kChargeRetry;
     spdlog::warn("no {} vertex could be reached", charger ? "charger" : "parking");

@@ -3,6 +3,8 @@
 // vertex. Without it two vehicles waiting for each other's place would wait until their
 // orders fail (the route limit), like openTCS's idle vehicles that block a destination.
 
+#include <utility>
+
 #include <spdlog/spdlog.h>
 
 #include "agents/logical_agent/src/logical_agent.hpp"
@@ -58,8 +60,12 @@ bool LogicalAgent::make_way(const std::string& requester) {
   spdlog::info("making way for '{}': leaving '{}' for a free parking vertex", requester, topology_->id(*vertex_));
   making_way_ = true;
   const Activity driving = drive_activity_;  // the order's drive resumes afterwards
+  // Nested in the order's drive: a pause meanwhile is the outer drive's to notice itself,
+  // so a later real failure of it is not taken for a stop for the pause.
+  const bool stopped_for_pause = std::exchange(stopped_for_pause_, false);
   const bool moved = drive_to_nearest(topology::VertexKind::parking, false);
   drive_activity_ = driving;
+  stopped_for_pause_ = stopped_for_pause;
   making_way_ = false;
   if (!moved) spdlog::info("could not make way for '{}': no free parking vertex reachable", requester);
   return moved;
