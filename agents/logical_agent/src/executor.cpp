@@ -993,6 +993,7 @@ void LogicalAgent::execute_order() {
 }
 
 bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do) {
+  stopped_for_pause_ = false;  // this search's own stop, for its caller to read
   if (here_will_do && topology_->vertex(*vertex_).kind == kind) return true;
   const auto here = topology_->vertex(*vertex_).position;
   std::vector<topology::EntityIndex> candidates;
@@ -1024,7 +1025,6 @@ bool LogicalAgent::drive_to_nearest(topology::VertexKind kind, bool here_will_do
 
 void LogicalAgent::go_to_service_vertex(topology::VertexKind kind) {
   const bool charger = kind == topology::VertexKind::charger;
-  stopped_for_pause_ = false;
   const bool reached = drive_to_nearest(kind, true);
   idle_since_ = clock_.now();
   // Stopped for the pause, not failed, or reached just as the pause came: nothing is begun
