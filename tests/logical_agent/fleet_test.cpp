@@ -214,6 +214,7 @@ struct Observations {
   std::map<std::string, std::string> holders;                       ///< entity -> agent, now
   std::vector<std::string> hold_violations;                         ///< conflicting holders seen
   std::map<std::string, ran::VehicleStatus> latest;                 ///< vehicle -> status
+  std::map<std::string, msg::VehicleState> vehicles;                ///< vehicle -> logical agent's state
   std::vector<std::string> overlaps;                                ///< footprints overlapping
   std::map<std::string, std::vector<std::pair<TimeNs, TimeNs>>> on_bar;  ///< vehicle -> times on bar-2
   std::map<std::string, std::vector<std::pair<TimeNs, std::string>>> holder_log;  ///< entity -> (time, allocated to)
@@ -250,6 +251,14 @@ class FleetTest : public ::testing::Test {
                                                             });
     ASSERT_TRUE(progress.has_value());
     progress_ = std::move(*progress);
+    auto states = dds::Reader<msg::VehicleState>::create(*participant_, logical_agent::kVehicleStateTopic,
+                                                           [this](const msg::VehicleState& sample) {
+                                                             std::lock_guard lock(seen_.mutex);
+                                                             seen_.vehicles[sample.vehicle()] = sample;
+                                                             seen_.changed.notify_all();
+                                                           });
+    ASSERT_TRUE(states.has_value());
+    vehicle_states_ = std::move(*states);
     dds::ReaderOptions events;
     events.qos = dds::TopicQos::events();
     auto notices = dds::Reader<msg::ReservationNotice>::create(
@@ -308,6 +317,7 @@ class FleetTest : public ::testing::Test {
     topology_events_.reset();
     alarms_.reset();
     notices_.reset();
+    vehicle_states_.reset();
     progress_.reset();
     participant_.reset();
   }
@@ -407,6 +417,17 @@ class FleetTest : public ::testing::Test {
         timeout);
   }
 
+  /// Waits until the state `vehicle`'s logical agent publishes satisfies `condition`.
+  bool wait_vehicle_state(const std::string& vehicle, const std::function<bool(const msg::VehicleState&)>& condition,
+                          std::chrono::seconds timeout = 60s) {
+    return seen_.wait(
+        [&] {
+          auto found = seen_.vehicles.find(vehicle);
+          return found != seen_.vehicles.end() && condition(found->second);
+        },
+        timeout);
+  }
+
   /// Starts vehicle V1 on left-0, sends it order `name` to right-4 and waits until it drives.
   void send_v1_across(Fleet& fleet, const std::string& name) {
     fleet.start_vehicle("V1", "left-0");
@@ -486,6 +507,7 @@ class FleetTest : public ::testing::Test {
   Observations seen_;
   std::unique_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_;
+  std::unique_ptr<dds::Reader<msg::VehicleState>> vehicle_states_;
   std::unique_ptr<dds::Reader<msg::ReservationNotice>> notices_;
   std::unique_ptr<dds::Reader<msg::OperatorAlarm>> alarms_;
   std::unique_ptr<dds::Reader<msg::TopologyEvent>> topology_events_;
@@ -911,19 +933,8 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   Fleet fleet(kDomain, "pause");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  std::mutex states_mutex;
-  std::condition_variable states_changed;
-  std::optional<msg::VehicleState> state;
-  auto states = dds::Reader<msg::VehicleState>::create(*participant_, logical_agent::kVehicleStateTopic,
-                                                       [&](const msg::VehicleState& sample) {
-                                                         std::lock_guard lock(states_mutex);
-                                                         state = sample;
-                                                         states_changed.notify_all();
-                                                       });
-  ASSERT_TRUE(states.has_value());
   const auto wait_state = [&](const std::function<bool(const msg::VehicleState&)>& condition) {
-    std::unique_lock lock(states_mutex);
-    return states_changed.wait_for(lock, 60s, [&] { return state && condition(*state); });
+    return wait_vehicle_state("V1", condition);
   };
   fleet.start_vehicle("V1", "left-0", {},
                       {"--park-after", "-1", "--charge-below", "0", "--db", (fleet.dir() / "V1.db").string()});
@@ -1003,7 +1014,6 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   // A vehicle no logical agent serves: nobody answers.
   EXPECT_EQ(droverctl(fleet, "pause-nobody", {"pause", "V9", "--timeout", "1", "--domain", domain}, out, err), 3)
       << out << err;
-  states->reset();
   std::lock_guard lock(seen_.mutex);
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   for (const auto& alarm : seen_.alarms) {
