@@ -1,7 +1,7 @@
 // `droverctl alarms [--domain N] [--min-severity S] [--duration S] [--json]`: follows the
 // operator alarms of a domain (drover/operator/alarm) as they are raised, one line each,
-// until Ctrl-C, SIGTERM or the end of --duration. Alarms are events: those raised before
-// it started are not shown.
+// until Ctrl-C, SIGTERM or the end of --duration. Each agent keeps its latest alarms
+// (logical_agent::kAlarmsKept) for readers that match it later: those are shown first.
 
 #include <signal.h>
 
@@ -97,8 +97,8 @@ int run_alarms(const AlarmsArguments& arguments) {
   }
   std::mutex output;  // alarms arrive on the reader's thread
   bool write_failed = false;
-  dds::ReaderOptions events;
-  events.qos = dds::TopicQos::events();
+  dds::ReaderOptions kept_and_new;
+  kept_and_new.qos = dds::TopicQos::log_reader();
   auto reader = dds::Reader<msg::OperatorAlarm>::create(
       **participant, logical_agent::kAlarmTopic,
       [&](const msg::OperatorAlarm& alarm) {
@@ -112,7 +112,7 @@ int run_alarms(const AlarmsArguments& arguments) {
           dds::request_shutdown();
         }
       },
-      events);
+      kept_and_new);
   if (!reader) {
     std::cerr << "error: " << reader.error().message << "\n";
     return kExitFailure;

@@ -215,23 +215,13 @@ TEST_F(DroverctlTest, OrdersExitsWithCode3WhenNoLogicalAgentAnswersAndRefusesBad
   EXPECT_EQ(status->code, 2) << err;
 }
 
-TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm) {
+TEST_F(DroverctlTest, AlarmsShowsTheKeptAlarmsThenFollowsNewOnesFromTheChosenSeverityUntilSigterm) {
   constexpr std::uint32_t kDomain = 44;
   auto agent = make_participant(kDomain, "V1");
   ASSERT_TRUE(agent);
-  auto writer = dds::Writer<msg::OperatorAlarm>::create(*agent, logical_agent::kAlarmTopic, dds::TopicQos::events());
+  auto writer = dds::Writer<msg::OperatorAlarm>::create(*agent, logical_agent::kAlarmTopic,
+                                                      dds::TopicQos::log_writer(logical_agent::kAlarmsKept));
   ASSERT_TRUE(writer.has_value());
-
-  const std::string out_file = ::testing::TempDir() + "droverctl_alarms.out";
-  const std::string err_file = ::testing::TempDir() + "droverctl_alarms.err";
-  auto child = ChildProcess::spawn(binary_path("droverctl"),
-                                   {"alarms", "--domain", std::to_string(kDomain), "--min-severity", "warning",
-                                    "--json"},
-                                   out_file, err_file);
-  ASSERT_TRUE(child.has_value());
-  children_.push_back(std::move(*child));
-  // Alarms are events: only those written once droverctl's reader matched reach it.
-  ASSERT_TRUE((*writer)->wait_for_readers(1, kDiscoveryTimeout));
   const auto alarm = [](msg::AlarmSeverity severity, const std::string& text) {
     msg::OperatorAlarm a;
     a.agent("V1");
@@ -241,13 +231,24 @@ TEST_F(DroverctlTest, AlarmsFollowsTheAlarmsFromTheChosenSeverityOnUntilSigterm)
     a.time().ns(seconds_to_ns(12.5));
     return a;
   };
-  ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_INFO, "route re-planned")).has_value());
+  // Raised before droverctl started: the agent keeps it, so it is shown all the same.
   ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_CRITICAL, "left its allocated area")).has_value());
+
+  const std::string out_file = ::testing::TempDir() + "droverctl_alarms.out";
+  const std::string err_file = ::testing::TempDir() + "droverctl_alarms.err";
+  auto child = ChildProcess::spawn(binary_path("droverctl"),
+                                   {"alarms", "--domain", std::to_string(kDomain), "--min-severity", "warning",
+                                    "--json"},
+                                   out_file, err_file);
+  ASSERT_TRUE(child.has_value());
+  children_.push_back(std::move(*child));
+  ASSERT_TRUE((*writer)->wait_for_readers(1, kDiscoveryTimeout));
+  ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_INFO, "route re-planned")).has_value());
   // A RAN's reason may carry a line break or bytes that are not UTF-8: still one valid line.
   ASSERT_TRUE((*writer)->write(alarm(msg::ALARM_ERROR, "caf\xe9\nforged")).has_value());
 
-  // The critical and error ones show (written after the info one, on a reliable topic: that
-  // one arrived first and was left out).
+  // The kept critical one shows first, then the error one (written after the info one, on a
+  // reliable topic: that one arrived before it and was left out).
   std::string out;
   const auto deadline = std::chrono::steady_clock::now() + kDiscoveryTimeout;
   while (out.find("forged") == std::string::npos && std::chrono::steady_clock::now() < deadline) {

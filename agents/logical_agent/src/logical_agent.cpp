@@ -103,7 +103,8 @@ Status LogicalAgent::start() {
   auto vehicle = dds::Writer<msg::VehicleState>::create(*participant_, kVehicleStateTopic);
   if (!vehicle) return unexpected(vehicle.error());
   vehicle_writer_ = std::move(*vehicle);
-  auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, dds::TopicQos::events());
+  auto alarms =
+      dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, dds::TopicQos::log_writer(kAlarmsKept));
   if (!alarms) return unexpected(alarms.error());
   alarm_writer_ = std::move(*alarms);
   auto make_way = dds::Writer<msg::MakeWayRequest>::create(*participant_, kMakeWayTopic, dds::TopicQos::events());

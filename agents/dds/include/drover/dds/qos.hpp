@@ -29,6 +29,14 @@ struct TopicQos {
   /// Request and reply topics of services: as events; a reply is only written once the
   /// requester's reply reader has matched, so nothing needs to be kept for late joiners.
   static TopicQos service() { return events(); }
+  /// Event logs (operator alarms), writer side: RELIABLE + TRANSIENT_LOCAL + KEEP_LAST(depth),
+  /// so that a reader that matches later still gets the writer's last `depth` samples: an
+  /// operator's console started after the agent, or an agent's first events written before
+  /// discovery matched its readers (a VOLATILE writer loses those).
+  static TopicQos log_writer(std::int32_t depth) { return TopicQos{true, depth, {}}; }
+  /// Event logs, reader side: RELIABLE + TRANSIENT_LOCAL + KEEP_ALL, so that a burst (the
+  /// kept samples of every writer at once) is taken whole.
+  static TopicQos log_reader() { return TopicQos{true, 0, {}}; }
 };
 
 /// The DataWriterQos for `qos` (RELIABLE; write() blocks at most 1 s on a full history;

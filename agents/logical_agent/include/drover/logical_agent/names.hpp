@@ -2,6 +2,8 @@
 // Where logical agents meet their clients on DDS (docs/logical-agent.md, "On the wire").
 // A logical agent's id is its vehicle's id; its RAN's id is ran::ran_agent_id(vehicle id).
 
+#include <cstdint>
+
 namespace drover::logical_agent {
 
 /// Service drover/logical/order/{request,reply}: OrderRequest / OrderReply, addressed to
@@ -18,8 +20,11 @@ inline constexpr const char* kPauseService = "pause";
 inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progress";
 /// State topic of VehicleState, keyed on the vehicle id.
 inline constexpr const char* kVehicleStateTopic = "drover/logical/vehicle";
-/// Event topic of OperatorAlarm (RELIABLE + VOLATILE + KEEP_ALL).
+/// Event log topic of OperatorAlarm (dds::TopicQos::log_writer(kAlarmsKept) and
+/// log_reader()): a reader that matches an agent late still gets its recent alarms.
 inline constexpr const char* kAlarmTopic = "drover/operator/alarm";
+/// How many of its latest alarms each writer keeps for readers that match later.
+inline constexpr std::int32_t kAlarmsKept = 100;
 /// Event topic of MakeWayRequest (RELIABLE + VOLATILE + KEEP_ALL), read filtered on `vehicle`.
 inline constexpr const char* kMakeWayTopic = "drover/logical/make_way";
 
