@@ -190,6 +190,14 @@ TEST_F(DroverctlTest, PauseAndResumeExitWithCode3WhenNoLogicalAgentAnswersAndRef
     status = run_droverctl({command, "--domain", "43"}, out, err);
     ASSERT_TRUE(status.has_value());
     EXPECT_EQ(status->code, 2) << command << " without a vehicle: " << err;
+    status = run_droverctl({command, "V9", "--all", "--domain", "43"}, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 2) << command << " with a vehicle and --all: " << err;
+    EXPECT_NE(err.find("name one VEHICLE or give --all"), std::string::npos) << err;
+    status = run_droverctl({command, "--all", "--domain", "43", "--timeout", "0.5"}, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 3) << command << " --all with no logical agent: " << err;
+    EXPECT_NE(err.find("no logical agent answered on domain 43 within 0.5 s"), std::string::npos) << err;
   }
   auto status = run_droverctl({"pause", "V9", "--wait", "-1", "--domain", "43"}, out, err);
   ASSERT_TRUE(status.has_value());

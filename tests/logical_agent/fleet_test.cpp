@@ -934,13 +934,16 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   constexpr std::uint32_t kDomain = 106;
   Fleet fleet(kDomain, "pause");
   fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1"});
+  watch(kDomain, fleet, {"V1", "V2"});
   const auto wait_state = [&](const std::function<bool(const msg::VehicleState&)>& condition) {
     return wait_vehicle_state("V1", condition);
   };
   fleet.start_vehicle("V1", "left-0", {},
                       {"--park-after", "-1", "--charge-below", "0", "--db", (fleet.dir() / "V1.db").string()});
   ASSERT_TRUE(wait_ready("V1", "left-0"));
+  // V2 stands idle off V1's way: a pause of V1 leaves it alone, a pause of all takes it too.
+  fleet.start_vehicle("V2", "right-0", {}, {"--park-after", "-1", "--charge-below", "0"});
+  ASSERT_TRUE(wait_ready("V2", "right-0"));
   ASSERT_EQ(send_order("V1", "trip", {{"right-4", "NOP"}}), "");
   ASSERT_EQ(send_order("V1", "back", {{"left-0", "NOP"}}), "");
   ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed > 0; }, 60s))
@@ -980,10 +983,12 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
       << "V1's next life is not paused";
   ASSERT_EQ(droverctl(fleet, "vehicles", {"vehicles", "--json", "--domain", domain}, out, err), 0) << err;
   const auto listed = nlohmann::json::parse(out);
-  ASSERT_EQ(listed.size(), 1u) << out;
+  ASSERT_EQ(listed.size(), 2u) << out;
   EXPECT_EQ(listed[0]["state"], "paused") << out;
   EXPECT_EQ(listed[0]["paused"], true) << out;
   EXPECT_EQ(listed[0]["pause_reason"], "aisle blocked") << out;
+  EXPECT_EQ(listed[1]["vehicle"], "V2") << out;
+  EXPECT_EQ(listed[1]["paused"], false) << out;
   EXPECT_TRUE(seen_.wait([&] { return seen_.holders[paused_at] == "V1"; }, 60s)) << "V1's next life holds nothing";
   {
     std::lock_guard lock(seen_.mutex);
@@ -1006,13 +1011,25 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   ASSERT_TRUE(back.has_value()) << "order back did not end";
   EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
   EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }));
-  // Paused and resumed while idle: idle again (ready for the next order), not paused.
-  ASSERT_EQ(droverctl(fleet, "pause-idle", {"pause", "V1", "--wait", "60", "--domain", domain}, out, err), 0)
+  // All paused and resumed while idle: idle again (ready for the next order), not paused.
+  ASSERT_EQ(droverctl(fleet, "pause-all", {"pause", "--all", "--reason", "shift change", "--wait", "60", "--domain",
+                                           domain},
+                      out, err),
+            0)
       << out << err;
-  ASSERT_TRUE(wait_state([](const msg::VehicleState& s) { return s.paused() && s.state() == msg::VEHICLE_PAUSED; }));
-  ASSERT_EQ(droverctl(fleet, "resume-idle", {"resume", "V1", "--domain", domain}, out, err), 0) << out << err;
-  EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
-      << "V1 resumed with nothing to do is not idle";
+  EXPECT_NE(out.find("vehicle 'V1' stands paused"), std::string::npos) << out;
+  EXPECT_NE(out.find("vehicle 'V2' stands paused"), std::string::npos) << out;
+  for (const char* vehicle : {"V1", "V2"}) {
+    EXPECT_TRUE(wait_vehicle_state(vehicle, [](const msg::VehicleState& s) {
+      return s.paused() && s.pause_reason() == "shift change" && s.state() == msg::VEHICLE_PAUSED;
+    })) << vehicle << " not paused by pause --all";
+  }
+  ASSERT_EQ(droverctl(fleet, "resume-all", {"resume", "--all", "--domain", domain}, out, err), 0) << out << err;
+  for (const char* vehicle : {"V1", "V2"}) {
+    EXPECT_TRUE(wait_vehicle_state(
+        vehicle, [](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
+        << vehicle << " resumed with nothing to do is not idle";
+  }
   // A vehicle no logical agent serves: nobody answers.
   EXPECT_EQ(droverctl(fleet, "pause-nobody", {"pause", "V9", "--timeout", "1", "--domain", domain}, out, err), 3)
       << out << err;
