@@ -37,7 +37,6 @@ Status TopologyAgent::watch_logical_agents() {
                                                                                          kServiceArea, "holdings");
     if (!holdings) return unexpected(holdings.error());
     holdings_client_ = std::move(*holdings);
-    owe_heartbeats();  // before the directory: its first word of an agent may come at once
   }
   dds::AgentDirectoryOptions watch;
   watch.on_change = [this](const dds::AgentRecord& record) { on_agent_change(record); };

@@ -147,6 +147,10 @@ Status TopologyAgent::start() {
 
   expiry_thread_ = std::thread([this] { run_expiry(); });
 
+  // Before any request is served: only what the journal restored is owed a heartbeat, not
+  // what an agent reserves while this agent is still starting.
+  if (options_.departed_after.count() > 0) owe_heartbeats();
+
   // Every handler takes the one mutex: requests are applied one at a time, whole.
   auto serve = [this]<class Req, class Rep>(Server<Req, Rep>& server, const char* service,
                                             void (TopologyAgent::*handler)(const Req&, dds::ReplyHandle<Rep>))

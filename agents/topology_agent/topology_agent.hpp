@@ -128,6 +128,8 @@ class TopologyAgent {
   bool heard_alive(const std::string& agent);
   /// Makes a sweep due departed_after from now for every agent with reservations here (a
   /// journal's), called off by its first heartbeat (on_agent_change).
+  /// \pre called before any request is served and before the directory exists (its first
+  ///      word of an agent may come at once)
   void owe_heartbeats();
   /// From the directory's thread: a logical agent died (its sweep is due departed_after
   /// later) or came back (nothing is due).

@@ -192,6 +192,37 @@ class TopologyAgentTest : public ::testing::Test {
     events_.clear();
   }
 
+  /// Waits until the agent's notice writer delivers to this tester, then forgets what it
+  /// delivered (as wait_for_event_delivery does for events; the notices come from another
+  /// writer, matched on its own): holds of agent "probe" on `entity`, far in the future,
+  /// that expire at once (the agent expires holds every 100 ms), until a
+  /// NOTICE_PREPARE_EXPIRED arrives.
+  void wait_for_notice_delivery(const std::string& entity) {
+    constexpr TimeNs kFar = seconds_to_ns(1e6);
+    const auto expired = [&](topology::RouteId route) {
+      return std::any_of(notices_.begin(), notices_.end(), [&](const msg::ReservationNotice& notice) {
+        return notice.agent() == "probe" && notice.kind() == msg::NOTICE_PREPARE_EXPIRED && notice.route() == route;
+      });
+    };
+    bool delivered = false;
+    for (topology::RouteId route = 1; route <= 20 && !delivered; ++route) {
+      // Each probe a window of its own: a hold whose notice was lost never refuses the next.
+      const TimeNs start = kFar + static_cast<TimeNs>(route) * 10;
+      auto prepared = prepare_->call(
+          prepare_request("probe", route, items("probe", route, {{entity, {start, start + 1}}}), {},
+                          SharedClock::wall().now()),
+          kDiscoveryTimeout);
+      ASSERT_TRUE(prepared.has_value()) << prepared.error().message;
+      ASSERT_EQ(prepared->error().code(), msg::ERROR_NONE) << prepared->error().message();
+      std::unique_lock guard(mutex_);
+      delivered = changed_.wait_for(guard, 1s, [&] { return expired(route); });
+    }
+    ASSERT_TRUE(delivered) << "no reservation notice reached the tester";
+    std::lock_guard guard(mutex_);
+    notices_.clear();
+    events_.clear();
+  }
+
   /// Waits until `condition` (called with the mutex held) holds. \return whether it did.
   template <class Condition>
   bool wait_until(Condition condition) {
@@ -367,6 +398,7 @@ TEST_F(TopologyAgentTest, CommittedReservationShowsOnTheTimelineAndAConflictingP
 TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderHoldingsShowItAndAQueuedRequesterIsAnsweredOnRelease) {
   start_agent(71);
   connect(71);
+  ASSERT_NO_FATAL_FAILURE(wait_for_notice_delivery("d"));
   reserve("v1", 1, {{"b", {1000, 2000}}});
   reserve("v2", 1, {{"b", {3000, 4000}}});
 
@@ -582,6 +614,7 @@ TEST_F(TopologyAgentTest, BadRequestsGetAnErrorReplyAndChangeNothing) {
 TEST_F(TopologyAgentTest, DelayShiftsThePushedRouteAndNotifiesEveryAffectedAgent) {
   start_agent(74);
   connect(74);
+  ASSERT_NO_FATAL_FAILURE(wait_for_notice_delivery("d"));
   reserve("v1", 1, {{"a", {1000, 2000}}});
   reserve("v2", 1, {{"a", {2000, 3000}}});
   msg::DelayRequest request;
@@ -748,6 +781,7 @@ TEST_F(TopologyAgentTest, ARouteItsOwnAgentCancelledIsNotReservedAgain) {
 TEST_F(TopologyAgentTest, APreparedHoldThatIsNeverCommittedExpires) {
   start_agent(76);
   connect(76);
+  ASSERT_NO_FATAL_FAILURE(wait_for_notice_delivery("d"));
   auto prepared = prepare_->call(
       prepare_request("v1", 1, items("v1", 1, {{"b", {1000, 2000}}}), {}, SharedClock::wall().now() + seconds_to_ns(1)),
       kDiscoveryTimeout);

@@ -132,7 +132,9 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto dir = scratch_dir("launch_duration");
   write_text(dir / "fleet.json", loop_launch(95, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
-  auto launcher = start_launch(dir, {"--duration", "30", "--trace", (dir / "trace.jsonl").string()});
+  // 100 simulated seconds at time factor 10: 10 s for both agents to start, discover each
+  // other and trace a status, on a loaded host too.
+  auto launcher = start_launch(dir, {"--duration", "100", "--trace", (dir / "trace.jsonl").string()});
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(120s);
   ASSERT_TRUE(status.has_value()) << "the launcher did not stop after --duration";
@@ -140,7 +142,7 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   EXPECT_EQ(status->code, 0) << read_file((dir / "err.txt").string());
   const auto out = read_file((dir / "out.txt").string());
   EXPECT_NE(out.find("summary of loop test"), std::string::npos) << out;
-  EXPECT_NE(out.find("stopped on --duration 30 s"), std::string::npos) << out;
+  EXPECT_NE(out.find("stopped on --duration 100 s"), std::string::npos) << out;
   const auto trace = read_file((dir / "trace.jsonl").string());
   EXPECT_EQ(trace.rfind("{\"t\":", 0), 0u) << trace.substr(0, 200);
   EXPECT_NE(trace.find("\"type\":\"launch\""), std::string::npos);

@@ -27,6 +27,7 @@
 #include <nlohmann/json.hpp>
 #include <gtest/gtest.h>
 
+#include "drover/dds/heartbeat_publisher.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
@@ -49,6 +50,9 @@ using namespace std::chrono_literals;
 /// Generous bound for a whole run on a loaded 2-core machine.
 constexpr auto kRunTimeout = 240s;
 constexpr double kTimeFactor = 2.0;
+/// Two vehicle statuses this close on the shared clock show the vehicles at the same moment
+/// (a simulated RAN reports every 0.1 s of real time, 0.2 s at kTimeFactor).
+constexpr DurationNs kSameMoment = seconds_to_ns(0.3);
 
 std::string source_dir() {
   const char* dir = std::getenv("DROVER_SOURCE_DIR");
@@ -231,7 +235,11 @@ struct Observations {
 
 class FleetTest : public ::testing::Test {
  protected:
-  void watch(std::uint32_t domain, const Fleet& fleet, const std::vector<std::string>& vehicles) {
+  /// Follows what `fleet` on `domain` does: orders, vehicle states, notices, alarms, the
+  /// events of its `topology_agents` topology agents (waited for: none may be missed) and
+  /// the statuses of `vehicles`.
+  void watch(std::uint32_t domain, const Fleet& fleet, const std::vector<std::string>& vehicles,
+             std::size_t topology_agents = 1) {
     auto loaded = topology::load_topology_file(fleet.topology_file());
     ASSERT_TRUE(loaded.has_value());
     world_ = std::make_shared<topology::Topology>(std::move(*loaded));
@@ -242,6 +250,14 @@ class FleetTest : public ::testing::Test {
     auto participant = dds::Participant::create(options);
     ASSERT_TRUE(participant.has_value()) << participant.error().message;
     participant_ = std::move(*participant);
+    // The tester beats like an agent: droverctl's discovery (vehicles, orders, pause --all)
+    // then ends once every participant present has shown its heartbeat, instead of always
+    // at its timeout with what it heard by then.
+    dds::HeartbeatOptions beat;
+    beat.kind = "tester";
+    auto heartbeat = dds::HeartbeatPublisher::create(*participant_, *clock_, std::move(beat));
+    ASSERT_TRUE(heartbeat.has_value()) << heartbeat.error().message;
+    heartbeat_ = std::move(*heartbeat);
 
     auto progress = dds::Reader<msg::OrderProgress>::create(*participant_, logical_agent::kOrderProgressTopic,
                                                             [this](const msg::OrderProgress& sample) {
@@ -302,7 +318,8 @@ class FleetTest : public ::testing::Test {
     ASSERT_TRUE(orders.has_value());
     order_client_ = std::move(*orders);
     // Nothing the topology agent does may be missed.
-    ASSERT_TRUE(topology_events_->wait_for_writers(1, 60s)) << "the topology agent's events never matched";
+    ASSERT_TRUE(topology_events_->wait_for_writers(topology_agents, 60s))
+        << "the topology agents' events never matched";
   }
 
   /// Whether `vehicle` raised an alarm of `severity` whose text contains `part`.
@@ -321,13 +338,16 @@ class FleetTest : public ::testing::Test {
     notices_.reset();
     vehicle_states_.reset();
     progress_.reset();
+    heartbeat_.reset();
     participant_.reset();
   }
 
   void on_event(const msg::TopologyEvent& event) {
     std::lock_guard lock(seen_.mutex);
-    // A restarted topology agent counts its events anew from 1.
-    const bool restarted = event.serial() == 1 && seen_.last_serial != 0;
+    // A restarted topology agent counts its events anew from 1; its first ones may be
+    // written before its writer matched this reader (VOLATILE), so the next life starts at
+    // whatever serial arrives first.
+    const bool restarted = seen_.last_serial != 0 && event.serial() <= seen_.last_serial;
     if (!restarted && event.serial() != seen_.last_serial + 1) {
       seen_.hold_violations.push_back("topology event " + std::to_string(event.serial()) + " after " +
                                       std::to_string(seen_.last_serial) + ": events lost or out of order");
@@ -359,6 +379,10 @@ class FleetTest : public ::testing::Test {
     seen_.status_times[status.vehicle_id].push_back(status.time);
     for (const auto& [other, other_status] : seen_.latest) {
       if (other == status.vehicle_id) continue;
+      // Only footprints of about the same moment: each vehicle's statuses arrive on a reader
+      // thread of their own, and one that lags would show a vehicle where it no longer is.
+      // Both report every 0.2 s (shared clock), so an overlap that lasts is still compared.
+      if (std::abs(status.time - other_status.time) > kSameMoment) continue;
       const double area = topology::footprint_overlap_area(status.footprint, other_status.footprint);
       if (area > 1e-6) {
         seen_.overlaps.push_back(status.vehicle_id + " and " + other + " overlap by " + std::to_string(area) + " m^2");
@@ -508,6 +532,7 @@ class FleetTest : public ::testing::Test {
   std::optional<SharedClock> clock_;
   Observations seen_;
   std::unique_ptr<dds::Participant> participant_;
+  std::unique_ptr<dds::HeartbeatPublisher> heartbeat_;
   std::unique_ptr<dds::Reader<msg::OrderProgress>> progress_;
   std::unique_ptr<dds::Reader<msg::VehicleState>> vehicle_states_;
   std::unique_ptr<dds::Reader<msg::ReservationNotice>> notices_;
@@ -896,7 +921,7 @@ TEST_F(FleetTest, ALogicalAgentRestartedWhileAPartitionIsDownTakesOverWhatItLeft
                  std::string("topology-") + partition, "--db", (fleet.dir() / (std::string(partition) + ".db")).string()});
   }
   fleet.start("routing", {"routing-agent"});
-  watch(kDomain, fleet, {"V1", "V2"});
+  watch(kDomain, fleet, {"V1", "V2"}, 2);
   fleet.start_vehicle("V1", "right-4");
   fleet.start_vehicle("V2", "left-0");
   ASSERT_TRUE(wait_ready("V1", "right-4"));
@@ -1378,11 +1403,15 @@ TEST_F(FleetTest, VehicleOutOfReachKeepsWhatItWasAllowedOntoUntilItIsSeenStandin
   const auto& times = seen_.status_times["V1"];
   const auto first_back = std::find_if(times.begin(), times.end(), [&](TimeNs t) { return t > lost_at + kLost / 2; });
   ASSERT_NE(first_back, times.end());
+  ASSERT_NE(first_back, times.begin());
+  // The silence began with the last status before it (the fault took effect some time
+  // after it was asked for, later on a loaded host).
+  const TimeNs last_heard = *std::prev(first_back);
   // The entities already passed when the last status came may go (the vehicle has left
   // them); nothing after, until the vehicle is seen again.
   for (const auto& [time, agent] : seen_.releases) {
-    EXPECT_FALSE(agent == "V1" && time > lost_at + seconds_to_ns(2) && time < *first_back)
-        << "V1 released an entity " << ns_to_seconds(time - lost_at) << " s into its silence";
+    EXPECT_FALSE(agent == "V1" && time > last_heard + seconds_to_ns(2) && time < *first_back)
+        << "V1 released an entity " << ns_to_seconds(time - last_heard) << " s into its silence";
   }
   EXPECT_FALSE(alarm_seen(msg::ALARM_CRITICAL, "V1", "left its allocated area")) << "V1 drove outside what it held";
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
@@ -1442,7 +1471,8 @@ TEST_F(FleetTest, VehicleStrandedOnAnothersWayKeepsItsVertexReservedThenClearsTh
            alarm.text().find("cannot hold") != std::string::npos;
   });
   ASSERT_NE(stranded_alarm, seen_.alarms.end()) << "no 'cannot hold' warning from V1";
-  // Kept reserved, its vertex lets V1 drive off at its first or second try (every 10 s).
+  // Kept reserved, its vertex lets V1 drive off at its first or second try (every 10 s;
+  // the second and the drive to the parking vertex take about 15 s, more on a loaded host).
   // Without that, the next vehicle's reservation lay on it and no route led away until that
   // vehicle's own lateness happened to push it back (35 s and more).
   const TimeNs stranded_at = stranded_alarm->time().ns();
@@ -1453,7 +1483,7 @@ TEST_F(FleetTest, VehicleStrandedOnAnothersWayKeepsItsVertexReservedThenClearsTh
     }
   }
   ASSERT_TRUE(parked_at.has_value());
-  EXPECT_LE(*parked_at - stranded_at, seconds_to_ns(15)) << "V1 took long to clear the way";
+  EXPECT_LE(*parked_at - stranded_at, seconds_to_ns(25)) << "V1 took long to clear the way";
   EXPECT_EQ(seen_.holders["right-1"], "V2");
   EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   EXPECT_TRUE(seen_.overlaps.empty()) << seen_.overlaps.front();

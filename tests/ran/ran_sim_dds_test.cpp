@@ -48,7 +48,8 @@ class RanSimDds : public ::testing::Test {
         test::binary_path("drover"),
         {"ran-sim", "--id", "V1", "--topology", source_path("launch/topologies/loop.json"),
          "--at", "south-west", "--domain", std::to_string(domain), "--time-factor", "10",
-         "--load-duration", "2", "--custom-action", "beep=1", "--status-period-ms", "50",
+         // Operations last 0.5 s of real time: several 50 ms statuses report each running.
+         "--load-duration", "5", "--custom-action", "beep=5", "--status-period-ms", "50",
          "--log-level", "warn"});
     ASSERT_TRUE(child);
     vehicle_process.emplace(std::move(*child));

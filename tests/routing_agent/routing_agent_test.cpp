@@ -313,9 +313,10 @@ TEST_F(RoutingAgentTest, BadRequestsGetClearErrors) {
   use_line_topology();
   start_topology_agents(kDomain, topology_file_);
   start_routing_agent(kDomain, "routing-1", {"--learn-timeout", "1"});
-  connect(kDomain);
-  // Learnt the topology: a good test route comes back.
-  ASSERT_EQ(call(route_request("v1", "a", "c", false)).error().code(), msg::ERROR_NONE);
+  connect(kDomain, 2);
+  // Learnt the topology: a good test route comes back (asked again while the topology
+  // agents' descriptions have not reached the routing agent within its 1 s learn timeout).
+  ASSERT_TRUE(eventually_routes(route_request("v1", "a", "c", false), {"a", "a-b", "b", "b-c", "c"}));
 
   auto unknown = call(route_request("v1", "a", "nowhere", false));
   EXPECT_EQ(unknown.error().code(), msg::ERROR_NOT_FOUND);
