@@ -85,7 +85,7 @@ TEST(TopicTest, LateJoinerGetsTheLastStateOfEveryInstance) {
 }
 
 TEST(TopicTest, ARetiredInstanceIsNoLongerGivenToLateJoiners) {
-  constexpr std::uint32_t kDomain = 104;
+  constexpr std::uint32_t kDomain = 38;
   auto publisher = make_participant(kDomain, "publisher");
   auto subscriber = make_participant(kDomain, "subscriber");
   ASSERT_NE(publisher, nullptr);

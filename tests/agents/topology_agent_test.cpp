@@ -1,5 +1,5 @@
 // The topology agent as a process (`drover topology-agent`): the test process is its
-// client over DDS. Domains 60, 66..68, 70..78 and 105. Every agent is stopped with SIGTERM and must exit 0.
+// client over DDS. Domains 39, 60, 66..68 and 70..78. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 
@@ -459,7 +459,7 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderHoldingsShowItAnd
 // operator's droverctl release): one whose heartbeat the topology agent hears releases what
 // it holds itself, whatever the operator's tool believes.
 TEST_F(TopologyAgentTest, WhatALiveLogicalAgentHoldsIsReleasedOnlyByItself) {
-  constexpr std::uint32_t kDomain = 105;
+  constexpr std::uint32_t kDomain = 39;
   start_agent(kDomain, {"--departed-after", "0"});  // no sweep: only the heartbeats count
   connect(kDomain);
   reserve("v1", 1, {{"b", {1000, 2000}}});

@@ -1,7 +1,7 @@
 // Logical agents as processes with a topology agent, a routing agent and simulated RANs on
 // the bundled H-shaped crossing (launch/topologies/h_crossing.json). The test process
 // watches what a user could watch: RAN statuses, timelines, notices, order progress,
-// alarms. Domains 45..49, 69, 83..93, 99..103 and 106. Every agent is stopped with SIGTERM and must exit 0.
+// alarms. Domains 35..37, 45..49, 69, 83..93 and 99..101. Every agent is stopped with SIGTERM and must exit 0.
 
 #include <signal.h>
 #include <unistd.h>
@@ -841,7 +841,7 @@ TEST_F(FleetTest, AnActionTheRanNoLongerKnowsFailsTheRestoredOrderWithAnAlarmAnd
 }
 
 TEST_F(FleetTest, ARanRestartedMidLoadFailsTheOrderInsteadOfLeavingItWaitingForEver) {
-  constexpr std::uint32_t kDomain = 102;
+  constexpr std::uint32_t kDomain = 35;
   Fleet fleet(kDomain, "ran-restart-mid-load");
   std::vector<std::string> logical;
   ASSERT_NO_FATAL_FAILURE(start_v1_loading_with_an_order_journal(fleet, kDomain, logical));
@@ -904,7 +904,7 @@ bool wait_for_log(const std::filesystem::path& path, const std::string& text, st
 }
 
 TEST_F(FleetTest, ALogicalAgentRestartedWhileAPartitionIsDownTakesOverWhatItLeftThereOnceItIsBack) {
-  constexpr std::uint32_t kDomain = 103;
+  constexpr std::uint32_t kDomain = 36;
   Fleet fleet(kDomain, "late-take-over");
   // The H crossing with its right leg in partition "east", the rest in "west", each served
   // by a journaling topology agent. V1 stands on the station right-4, in "east".
@@ -956,7 +956,7 @@ TEST_F(FleetTest, ALogicalAgentRestartedWhileAPartitionIsDownTakesOverWhatItLeft
 }
 
 TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesOnWhenResumed) {
-  constexpr std::uint32_t kDomain = 106;
+  constexpr std::uint32_t kDomain = 37;
   Fleet fleet(kDomain, "pause");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1", "V2"});
