@@ -95,4 +95,14 @@ Result<std::vector<dds::AgentRecord>> discover_live_agents(
   return agents;
 }
 
+std::vector<std::string> live_logical_vehicles(const std::vector<dds::AgentRecord>& agents) {
+  std::vector<std::string> vehicles;
+  for (const auto& agent : agents) {
+    if (agent.kind == "logical" && agent.alive) vehicles.insert(vehicles.end(), agent.owns.begin(), agent.owns.end());
+  }
+  std::sort(vehicles.begin(), vehicles.end());
+  vehicles.erase(std::unique(vehicles.begin(), vehicles.end()), vehicles.end());
+  return vehicles;
+}
+
 }  // namespace drover::cli

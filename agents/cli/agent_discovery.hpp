@@ -1,9 +1,11 @@
 #pragma once
 // How droverctl learns which agents a domain has: from their heartbeats, within a discovery
-// window (see discover_live_agents). Shared by `droverctl agents` and `droverctl vehicles`.
+// window (see discover_live_agents). Shared by `droverctl agents`, `vehicles`, `orders` and
+// `pause --all`.
 
 #include <chrono>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "drover/common/result.hpp"
@@ -21,5 +23,9 @@ namespace drover::cli {
 Result<std::vector<dds::AgentRecord>> discover_live_agents(
     dds::Participant& participant, std::chrono::milliseconds timeout,
     const std::function<bool(const std::vector<dds::AgentRecord>&)>& also = {});
+
+/// The vehicles of the live logical agents among `agents` (a logical agent's heartbeat names
+/// the vehicle it owns), sorted, each once.
+std::vector<std::string> live_logical_vehicles(const std::vector<dds::AgentRecord>& agents);
 
 }  // namespace drover::cli

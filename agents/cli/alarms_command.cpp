@@ -140,7 +140,9 @@ int run_alarms(const AlarmsArguments& arguments) {
 void add_alarms_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<AlarmsArguments>();
   auto* command = app.add_subcommand(
-      "alarms", "Follow the operator alarms as they are raised, one line each, until Ctrl-C or --duration");
+      "alarms",
+      "Show the operator alarms the agents keep, then follow them as they are raised, one line each, until Ctrl-C or "
+      "--duration");
   add_dds_tool_options(*command, arguments->dds, 0);
   command->add_option("--min-severity", arguments->min_severity,
                       "Show alarms of this severity and above: info, warning, error, critical (default info)");

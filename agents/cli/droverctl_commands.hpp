@@ -18,8 +18,8 @@ void add_route_command(CLI::App& app, CommandContext& context);
 /// `droverctl order send VEHICLE LOCATION:OPERATION ...`: an order to one logical agent;
 /// `droverctl order withdraw VEHICLE ORDER`: withdraws one.
 void add_order_command(CLI::App& app, CommandContext& context);
-/// `droverctl pause VEHICLE`, `droverctl resume VEHICLE`: an operator stops a vehicle at the
-/// next vertex and lets it go on; agents/cli/pause_command.cpp.
+/// `droverctl pause (VEHICLE | --all)`, `droverctl resume (VEHICLE | --all)`: an operator
+/// stops a vehicle (or all) at the next vertex and lets it go on; agents/cli/pause_command.cpp.
 void add_pause_command(CLI::App& app, CommandContext& context);
 
 /// `droverctl lock ENTITY --from T --until T --reason TEXT`, `droverctl unlock LOCK_ID`,
@@ -35,7 +35,7 @@ void add_release_command(CLI::App& app, CommandContext& context);
 /// agents/cli/orders_command.cpp.
 void add_orders_command(CLI::App& app, CommandContext& context);
 /// `droverctl vehicles`: what every vehicle is doing, from its logical agent's state;
-/// `droverctl alarms`: follows the operator alarms as they are raised.
+/// `droverctl alarms`: shows the alarms the agents keep, then follows them as they are raised.
 void add_vehicles_command(CLI::App& app, CommandContext& context);
 void add_alarms_command(CLI::App& app, CommandContext& context);
 

@@ -13,27 +13,44 @@
 
 namespace drover::cli {
 
-/// Sends `request` through `client` to `vehicle`'s logical agent. \return its reply when the
-/// agent accepted the request; otherwise nullopt, with the reason printed on standard error
-/// and `exit_code` set: kExitNoAnswer when nobody answered in time, kExitFailure when the
-/// agent refused (`refused` says what it did not do: "refused order 'x'") or the call failed.
+/// What one vehicle's logical agent answered.
+template <class Reply>
+struct LogicalAgentAnswer {
+  std::optional<Reply> reply;  ///< present when the agent accepted the request
+  int exit_code = kExitOk;     ///< kExitNoAnswer, kExitFailure or kExitOk
+  std::string error;           ///< why not accepted, naming the vehicle; empty when accepted
+};
+
+/// Sends `request` through `client` to `vehicle`'s logical agent and waits for its answer.
+/// Prints nothing (callers asking several agents at once print the answers in order).
+/// `refused` says what the agent did not do when it refused ("refused order 'x'").
+/// \return the reply when accepted; otherwise kExitNoAnswer when nobody answered in time,
+///         kExitFailure when the agent refused or the call failed, with the reason.
+template <class Request, class Reply>
+LogicalAgentAnswer<Reply> ask_logical_agent(dds::ServiceClient<Request, Reply>& client, const DdsToolOptions& options,
+                                            const std::string& vehicle, const Request& request,
+                                            const std::string& refused) {
+  auto reply = client.call(request, options.timeout(), vehicle);
+  if (!reply) {
+    return {std::nullopt, reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure,
+            "vehicle '" + vehicle + "': " + reply.error().message};
+  }
+  if (auto status = dds::from_wire(reply->error()); !status) {
+    return {std::nullopt, kExitFailure, "vehicle '" + vehicle + "' " + refused + ": " + status.error().message};
+  }
+  return {std::move(*reply), kExitOk, {}};
+}
+
+/// As ask_logical_agent, for one vehicle: \return its reply when the agent accepted the
+/// request; otherwise nullopt, with the reason printed on standard error and `exit_code` set.
 template <class Request, class Reply>
 std::optional<Reply> call_logical_agent(dds::ServiceClient<Request, Reply>& client, const DdsToolOptions& options,
                                         const std::string& vehicle, const Request& request,
                                         const std::string& refused, int& exit_code) {
-  auto reply = client.call(request, options.timeout(), vehicle);
-  if (!reply) {
-    std::cerr << "error: vehicle '" << vehicle << "': " << reply.error().message << "\n";
-    exit_code = reply.error().code == ErrorCode::timeout ? kExitNoAnswer : kExitFailure;
-    return std::nullopt;
-  }
-  if (auto status = dds::from_wire(reply->error()); !status) {
-    std::cerr << "error: vehicle '" << vehicle << "' " << refused << ": " << status.error().message << "\n";
-    exit_code = kExitFailure;
-    return std::nullopt;
-  }
-  exit_code = kExitOk;
-  return std::move(*reply);
+  auto answer = ask_logical_agent(client, options, vehicle, request, refused);
+  if (!answer.reply) std::cerr << "error: " << answer.error << "\n";
+  exit_code = answer.exit_code;
+  return std::move(answer.reply);
 }
 
 }  // namespace drover::cli

@@ -78,10 +78,10 @@ int run_orders(const OrdersArguments& arguments) {
   }
   const auto orders = collected.orders();
   reader->reset();  // before `collected`, which its callback fills
-  const bool logical_heard = std::any_of(agents->begin(), agents->end(), [&](const dds::AgentRecord& agent) {
-    return agent.kind == "logical" && (arguments.vehicle.empty() || std::count(agent.owns.begin(), agent.owns.end(),
-                                                                               arguments.vehicle) > 0);
-  });
+  const auto vehicles = live_logical_vehicles(*agents);
+  const bool logical_heard = arguments.vehicle.empty()
+                                 ? !vehicles.empty()
+                                 : std::binary_search(vehicles.begin(), vehicles.end(), arguments.vehicle);
   if (!logical_heard && orders.empty()) {
     std::cerr << "error: no logical agent" << (arguments.vehicle.empty() ? "" : " of vehicle '" + arguments.vehicle + "'")
               << " answered on domain " << arguments.dds.domain_id << " within " << arguments.dds.timeout_seconds

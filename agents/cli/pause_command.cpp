@@ -3,7 +3,10 @@
 // docs/logical-agent.md "Pausing a vehicle"): it drives the moves already commanded, stops on
 // a vertex and begins nothing new until resumed. With --wait, also waits until the logical
 // agents report the vehicles standing paused.
-// `droverctl resume (VEHICLE | --all)`: lets them go on.
+// `droverctl resume (VEHICLE | --all [--reason TEXT])`: lets them go on.
+// With --all, a vehicle paused already is left as it is (its reason kept), and `resume --all
+// --reason TEXT` resumes only those paused for that reason: a fleet-wide pause and its end
+// never lift the pause an operator put on one vehicle for a reason of its own.
 // Exit 0: done (with --wait: all standing paused within S); 1: a vehicle refused (its
 // journal could not store it), did not answer (with --all), or did not stand paused within
 // --wait; 2: bad usage; 3: no logical agent of that vehicle (with --all: none at all)
@@ -11,11 +14,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
+#include <future>
 #include <iostream>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,7 @@
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/cli/logical_agent_call.hpp"
-#include "drover/dds/reader.hpp"
+#include "agents/cli/vehicle_states.hpp"
 #include "drover/dds/service_client.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
@@ -36,54 +37,82 @@ struct PauseArguments {
   DdsToolOptions dds;
   std::string vehicle;  ///< empty with --all
   bool all = false;
-  std::string reason;
+  std::string reason;  ///< pause: why; resume --all: only the vehicles paused for this
   double wait_seconds = 0;
 };
 
-/// Follows whether each vehicle stands paused, from its logical agent's state.
-class PausedWatch {
- public:
-  void on_state(const msg::VehicleState& state) {
-    std::lock_guard lock(mutex_);
-    standing_[state.vehicle()] = state.paused() && state.state() == msg::VEHICLE_PAUSED;
-    changed_.notify_all();
-  }
-  /// Waits until every one of `vehicles` stands paused, at most `timeout`.
-  /// \return those that do not stand paused then.
-  std::vector<std::string> wait(const std::vector<std::string>& vehicles, std::chrono::milliseconds timeout) {
-    std::unique_lock lock(mutex_);
-    changed_.wait_for(lock, timeout, [&] { return not_standing(vehicles).empty(); });
-    return not_standing(vehicles);
-  }
+using PauseClient = dds::ServiceClient<msg::VehiclePauseRequest, msg::StatusReply>;
 
- private:
-  /// \pre mutex_ is held
-  std::vector<std::string> not_standing(const std::vector<std::string>& vehicles) const {
-    std::vector<std::string> out;
-    for (const auto& vehicle : vehicles) {
-      const auto found = standing_.find(vehicle);
-      if (found == standing_.end() || !found->second) out.push_back(vehicle);
+bool standing_paused(const VehicleStates::States& states, const std::string& vehicle) {
+  const auto found = states.find(vehicle);
+  return found != states.end() && found->second.paused() && found->second.state() == msg::VEHICLE_PAUSED;
+}
+
+std::string reason_text(const msg::VehicleState& state) {
+  return state.pause_reason().empty() ? "no reason given" : "'" + state.pause_reason() + "'";
+}
+
+/// The vehicles `--all` asks, from the live logical agents and their states (`known`); says
+/// on standard output which it leaves as they are and why. `standing` gets the vehicles
+/// paused already (a --wait waits for them too).
+std::vector<std::string> vehicles_to_ask(const PauseArguments& arguments, bool pause,
+                                         const std::vector<std::string>& live, const VehicleStates::States& known,
+                                         std::vector<std::string>& standing) {
+  std::vector<std::string> asked;
+  for (const auto& vehicle : live) {
+    const auto found = known.find(vehicle);
+    if (found == known.end()) {
+      // Its state did not arrive: only a selective resume needs it.
+      if (!pause && !arguments.reason.empty()) {
+        std::cout << "vehicle '" << vehicle << "' left as it is: its state did not arrive, its pause reason is unknown\n";
+        continue;
+      }
+    } else if (pause && found->second.paused()) {
+      std::cout << "vehicle '" << vehicle << "' already paused (" << reason_text(found->second) << "): left as it is\n";
+      standing.push_back(vehicle);
+      continue;
+    } else if (!pause && !found->second.paused()) {
+      std::cout << "vehicle '" << vehicle << "' not paused\n";
+      continue;
+    } else if (!pause && !arguments.reason.empty() && found->second.pause_reason() != arguments.reason) {
+      std::cout << "vehicle '" << vehicle << "' left paused (" << reason_text(found->second) << ")\n";
+      continue;
     }
-    return out;
+    asked.push_back(vehicle);
   }
+  return asked;
+}
 
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::map<std::string, bool> standing_;
-};
-
-/// The vehicles of the live logical agents on the participant's domain, sorted.
-Result<std::vector<std::string>> live_vehicles(dds::Participant& participant, std::chrono::milliseconds timeout) {
-  const auto agents = discover_live_agents(participant, timeout);
-  if (!agents) return unexpected(agents.error());
-  std::vector<std::string> vehicles;
-  for (const auto& agent : *agents) {
-    if (agent.kind != "logical" || !agent.alive) continue;
-    vehicles.insert(vehicles.end(), agent.owns.begin(), agent.owns.end());
+/// Asks every vehicle at once (a logical agent that does not answer delays none of the
+/// others), then prints the answers in the order of `vehicles`. \return the vehicles that
+/// accepted; `failure` gets the exit code of a failure (kExitOk when none).
+std::vector<std::string> ask_all(PauseClient& client, const PauseArguments& arguments, bool pause,
+                                 const std::vector<std::string>& vehicles, int& failure) {
+  msg::VehiclePauseRequest request;
+  request.paused(pause);
+  if (pause) request.reason(arguments.reason);
+  const std::string refused = pause ? "was not paused" : "was not resumed";
+  std::vector<std::future<LogicalAgentAnswer<msg::StatusReply>>> answers;
+  for (const auto& vehicle : vehicles) {
+    answers.push_back(std::async(std::launch::async, [&, vehicle] {
+      return ask_logical_agent(client, arguments.dds, vehicle, request, refused);
+    }));
   }
-  std::sort(vehicles.begin(), vehicles.end());
-  vehicles.erase(std::unique(vehicles.begin(), vehicles.end()), vehicles.end());
-  return vehicles;
+  std::vector<std::string> accepted;
+  failure = kExitOk;
+  for (std::size_t i = 0; i < vehicles.size(); ++i) {
+    const auto answer = answers[i].get();
+    if (!answer.reply) {
+      std::cerr << "error: " << answer.error << "\n";
+      // Of several vehicles, one not answering is a failure of the command, not "nobody".
+      failure = arguments.all ? kExitFailure : answer.exit_code;
+      continue;
+    }
+    accepted.push_back(vehicles[i]);
+    std::cout << "vehicle '" << vehicles[i] << "' "
+              << (pause ? "paused: it stops at the next vertex it can" : "resumed") << "\n";
+  }
+  return accepted;
 }
 
 int run_pause(const PauseArguments& arguments, bool pause) {
@@ -91,66 +120,64 @@ int run_pause(const PauseArguments& arguments, bool pause) {
     std::cerr << "error: name one VEHICLE or give --all\n";
     return kExitBadInput;
   }
+  if (!pause && !arguments.reason.empty() && !arguments.all) {
+    std::cerr << "error: --reason on resume chooses among --all; a named vehicle is resumed whatever its reason\n";
+    return kExitBadInput;
+  }
   auto participant = open_tool_participant(arguments.dds);
   if (!participant) {
     std::cerr << "error: " << participant.error().message << "\n";
     return participant.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
   }
-  // The watch and its reader before the requests: the state that answers one may come at once.
-  PausedWatch watch;
-  std::unique_ptr<dds::Reader<msg::VehicleState>> states;
-  if (pause && arguments.wait_seconds > 0) {
-    auto reader = dds::Reader<msg::VehicleState>::create(
-        **participant, logical_agent::kVehicleStateTopic, [&watch](const msg::VehicleState& state) { watch.on_state(state); });
-    if (!reader) {
-      std::cerr << "error: " << reader.error().message << "\n";
+  // The states before the requests: the state that answers one may come at once.
+  std::unique_ptr<VehicleStates> states;
+  if (arguments.all || (pause && arguments.wait_seconds > 0)) {
+    auto follower = VehicleStates::create(**participant);
+    if (!follower) {
+      std::cerr << "error: " << follower.error().message << "\n";
       return kExitFailure;
     }
-    states = std::move(*reader);
+    states = std::move(*follower);
   }
-  std::vector<std::string> vehicles{arguments.vehicle};
+  std::vector<std::string> asked{arguments.vehicle};
+  std::vector<std::string> standing;  // paused already, left as they are
   if (arguments.all) {
-    auto live = live_vehicles(**participant, arguments.dds.timeout());
-    if (!live) {
-      std::cerr << "error: " << live.error().message << "\n";
+    // Every live logical agent, and its vehicle's state (what decides whether it is asked).
+    const auto agents = discover_live_agents(**participant, arguments.dds.timeout(), [&](const auto& records) {
+      const auto known = states->states();
+      const auto live = live_logical_vehicles(records);
+      return std::all_of(live.begin(), live.end(), [&](const std::string& v) { return known.count(v) > 0; });
+    });
+    if (!agents) {
+      std::cerr << "error: " << agents.error().message << "\n";
       return kExitFailure;
     }
-    if (live->empty()) {
+    const auto live = live_logical_vehicles(*agents);
+    if (live.empty()) {
       std::cerr << "error: no logical agent answered on domain " << arguments.dds.domain_id << " within "
                 << arguments.dds.timeout_seconds << " s\n";
       return kExitNoAnswer;
     }
-    vehicles = std::move(*live);
+    asked = vehicles_to_ask(arguments, pause, live, states->states(), standing);
   }
-  auto client = dds::ServiceClient<msg::VehiclePauseRequest, msg::StatusReply>::create(
-      **participant, logical_agent::kServiceArea, logical_agent::kPauseService);
+  auto client = PauseClient::create(**participant, logical_agent::kServiceArea, logical_agent::kPauseService);
   if (!client) {
     std::cerr << "error: " << client.error().message << "\n";
     return kExitFailure;
   }
-  msg::VehiclePauseRequest request;
-  request.paused(pause);
-  request.reason(arguments.reason);
-  // Every vehicle is asked even when one fails: an operator pausing the fleet wants as many
-  // of them paused as can be.
-  std::vector<std::string> done;
   int failure = kExitOk;
-  for (const auto& vehicle : vehicles) {
-    int code = kExitOk;
-    if (!call_logical_agent(**client, arguments.dds, vehicle, request, pause ? "was not paused" : "was not resumed",
-                            code)) {
-      failure = arguments.all ? kExitFailure : code;
-      continue;
-    }
-    done.push_back(vehicle);
-    std::cout << "vehicle '" << vehicle << "' " << (pause ? "paused: it stops at the next vertex it can" : "resumed")
-              << "\n";
-  }
-  if (pause && arguments.wait_seconds > 0 && !done.empty()) {
-    const auto late = watch.wait(done, std::chrono::milliseconds(static_cast<std::int64_t>(arguments.wait_seconds * 1000)));
-    states.reset();  // before the watch it calls
-    for (const auto& vehicle : done) {
-      if (std::find(late.begin(), late.end(), vehicle) == late.end()) {
+  auto waited = ask_all(**client, arguments, pause, asked, failure);
+  if (pause && arguments.wait_seconds > 0) {
+    waited.insert(waited.end(), standing.begin(), standing.end());
+    std::sort(waited.begin(), waited.end());
+    states->wait(
+        [&](const VehicleStates::States& known) {
+          return std::all_of(waited.begin(), waited.end(), [&](const std::string& v) { return standing_paused(known, v); });
+        },
+        std::chrono::milliseconds(static_cast<std::int64_t>(arguments.wait_seconds * 1000)));
+    const auto known = states->states();
+    for (const auto& vehicle : waited) {
+      if (standing_paused(known, vehicle)) {
         std::cout << "vehicle '" << vehicle << "' stands paused\n";
       } else {
         std::cerr << "error: vehicle '" << vehicle << "' not standing paused within " << arguments.wait_seconds
@@ -169,7 +196,7 @@ void add_pause_command(CLI::App& app, CommandContext& context) {
   auto* pause = app.add_subcommand(
       "pause", "Pause a vehicle, or all: it stops at the next vertex it can and begins nothing new until resumed");
   pause->add_option("vehicle", paused->vehicle, "The vehicle id");
-  pause->add_flag("--all", paused->all, "Every vehicle whose logical agent is alive");
+  pause->add_flag("--all", paused->all, "Every vehicle whose logical agent is alive (those paused already are left as they are)");
   pause->add_option("--reason", paused->reason, "Why (shown in droverctl vehicles)");
   pause->add_option("--wait", paused->wait_seconds,
                     "Also wait up to S seconds until the vehicles stand paused (exit 1 if one does not)")
@@ -180,7 +207,8 @@ void add_pause_command(CLI::App& app, CommandContext& context) {
   auto resumed = std::make_shared<PauseArguments>();
   auto* resume = app.add_subcommand("resume", "Resume a paused vehicle, or all");
   resume->add_option("vehicle", resumed->vehicle, "The vehicle id");
-  resume->add_flag("--all", resumed->all, "Every vehicle whose logical agent is alive");
+  resume->add_flag("--all", resumed->all, "Every paused vehicle whose logical agent is alive");
+  resume->add_option("--reason", resumed->reason, "With --all: only the vehicles paused for this reason");
   add_dds_tool_options(*resume, resumed->dds, 5.0);
   resume->callback([resumed, &context] { context.exit_code = run_pause(*resumed, false); });
 }

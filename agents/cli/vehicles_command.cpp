@@ -9,7 +9,6 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -20,10 +19,9 @@
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/cli/table.hpp"
+#include "agents/cli/vehicle_states.hpp"
 #include "drover/dds/agent_directory.hpp"
-#include "drover/dds/reader.hpp"
 #include "drover/logical_agent/messages.hpp"
-#include "drover/logical_agent/names.hpp"
 #include "drover/logical_agent/wire_names.hpp"
 
 namespace drover::cli {
@@ -34,33 +32,12 @@ struct VehiclesArguments {
   bool json = false;
 };
 
-/// The latest state of each vehicle, as it arrives.
-class VehicleStates {
- public:
-  void on_state(const msg::VehicleState& state) {
-    std::lock_guard lock(mutex_);
-    states_[state.vehicle()] = state;
-  }
-  std::map<std::string, msg::VehicleState> states() const {
-    std::lock_guard lock(mutex_);
-    return states_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::map<std::string, msg::VehicleState> states_;
-};
-
-/// The vehicles of live logical agents (their heartbeats name the vehicle they own) whose
-/// state has not arrived.
+/// The vehicles of live logical agents whose state has not arrived.
 std::vector<std::string> vehicles_unseen(const std::vector<dds::AgentRecord>& agents,
-                                         const std::map<std::string, msg::VehicleState>& states) {
+                                         const VehicleStates::States& states) {
   std::vector<std::string> unseen;
-  for (const auto& agent : agents) {
-    if (agent.kind != "logical" || !agent.alive) continue;
-    for (const auto& vehicle : agent.owns) {
-      if (states.count(vehicle) == 0) unseen.push_back(vehicle);
-    }
+  for (const auto& vehicle : live_logical_vehicles(agents)) {
+    if (states.count(vehicle) == 0) unseen.push_back(vehicle);
   }
   return unseen;
 }
@@ -86,7 +63,7 @@ std::string paused_text(const msg::VehicleState& state) {
   return state.pause_reason().empty() ? "yes" : state.pause_reason();
 }
 
-void print_vehicles(const std::map<std::string, msg::VehicleState>& states) {
+void print_vehicles(const VehicleStates::States& states) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& [vehicle, state] : states) {
     rows.push_back({vehicle, state_text(state), state.vertex().empty() ? "-" : state.vertex(),
@@ -96,7 +73,7 @@ void print_vehicles(const std::map<std::string, msg::VehicleState>& states) {
   print_table(std::cout, {"VEHICLE", "STATE", "VERTEX", "ORDER", "QUEUED", "MOVING", "BATTERY", "PAUSED"}, rows);
 }
 
-void print_json(const std::map<std::string, msg::VehicleState>& states) {
+void print_json(const VehicleStates::States& states) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& [vehicle, state] : states) {
     out.push_back({{"vehicle", vehicle},
@@ -120,26 +97,23 @@ int run_vehicles(const VehiclesArguments& arguments) {
     std::cerr << "error: " << participant.error().message << "\n";
     return participant.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
   }
-  VehicleStates collected;
-  auto reader = dds::Reader<msg::VehicleState>::create(
-      **participant, logical_agent::kVehicleStateTopic,
-      [&collected](const msg::VehicleState& state) { collected.on_state(state); });
-  if (!reader) {
-    std::cerr << "error: " << reader.error().message << "\n";
+  auto collected = VehicleStates::create(**participant);
+  if (!collected) {
+    std::cerr << "error: " << collected.error().message << "\n";
     return kExitFailure;
   }
   // Every logical agent present is discovered as `droverctl agents` does it, and has shown
   // its vehicle's state; never past the timeout.
   const auto agents = discover_live_agents(**participant, arguments.dds.timeout(), [&](const auto& records) {
-    const auto states = collected.states();
+    const auto states = (*collected)->states();
     return !states.empty() && vehicles_unseen(records, states).empty();
   });
   if (!agents) {
     std::cerr << "error: " << agents.error().message << "\n";
     return kExitFailure;
   }
-  const auto states = collected.states();
-  reader->reset();  // before `collected`, which its callback fills
+  const auto states = (*collected)->states();
+  collected->reset();
   const auto missing = vehicles_unseen(*agents, states);
   if (!missing.empty() && !states.empty()) {
     std::cerr << "warning: no state from the logical agent of";

@@ -1,6 +1,6 @@
-// droverctl as an operator runs it, a separate process: `agents`, `vehicles` and `alarms`
+// droverctl as an operator runs it, a separate process: `agents`, `vehicles`, `pause --all` and `alarms`
 // against live agents (dds_test_peer processes, or participants of the test process that
-// publish as logical agents do), and its bad usage. Domains 40..44.
+// publish as logical agents do), and its bad usage. Domains 18 and 40..44.
 
 #include <signal.h>
 
@@ -202,6 +202,40 @@ TEST_F(DroverctlTest, PauseAndResumeExitWithCode3WhenNoLogicalAgentAnswersAndRef
   auto status = run_droverctl({"pause", "V9", "--wait", "-1", "--domain", "43"}, out, err);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 2) << err;
+}
+
+TEST_F(DroverctlTest, PauseAllAsksEveryLiveVehicleLeavesPausedOnesAsTheyAreAndFailsNamingOneThatDoesNotAnswer) {
+  // Two logical agents as droverctl sees them, with no pause service: V7 idle, V8 paused by
+  // an operator for a reason of its own.
+  constexpr std::uint32_t kDomain = 18;
+  const std::string domain = std::to_string(kDomain);
+  FakeLogicalAgent v7(kDomain, vehicle_state("V7", msg::VEHICLE_IDLE, "aisle-1", "", 0.9, false));
+  auto paused = vehicle_state("V8", msg::VEHICLE_PAUSED, "aisle-2", "", 0.9, false);
+  paused.paused(true);
+  paused.pause_reason("bumper check");
+  FakeLogicalAgent v8(kDomain, paused);
+  std::string out, err;
+  // V7 is asked and does not answer: exit 1 naming it; V8 is left as it is.
+  auto status = run_droverctl({"pause", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "3"},
+                              out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 1) << out << err;
+  EXPECT_NE(err.find("vehicle 'V7'"), std::string::npos) << err;
+  EXPECT_NE(out.find("vehicle 'V8' already paused ('bumper check'): left as it is"), std::string::npos) << out;
+  EXPECT_EQ(err.find("vehicle 'V8'"), std::string::npos) << err;
+  // Resuming those paused for another reason: V8 stays paused, V7 is not paused; nothing
+  // is asked, so nothing fails.
+  status = run_droverctl({"resume", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "3"}, out,
+                         err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 0) << out << err;
+  EXPECT_NE(out.find("vehicle 'V8' left paused ('bumper check')"), std::string::npos) << out;
+  EXPECT_NE(out.find("vehicle 'V7' not paused"), std::string::npos) << out;
+  // --reason on the resume of one named vehicle is bad usage.
+  status = run_droverctl({"resume", "V8", "--reason", "bumper check", "--domain", domain}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2) << err;
+  EXPECT_NE(err.find("--reason on resume chooses among --all"), std::string::npos) << err;
 }
 
 TEST_F(DroverctlTest, VehiclesExitsWithCode3WhenNoLogicalAgentAnswers) {

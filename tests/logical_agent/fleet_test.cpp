@@ -1036,25 +1036,42 @@ TEST_F(FleetTest, APausedVehicleStopsOnAVertexStaysPausedThroughARestartAndGoesO
   ASSERT_TRUE(back.has_value()) << "order back did not end";
   EXPECT_EQ(back->state(), msg::ORDER_FINISHED) << back->failure();
   EXPECT_TRUE(wait_state([](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }));
-  // All paused and resumed while idle: idle again (ready for the next order), not paused.
+  // V2 paused on its own, then all: V1 pauses, V2 keeps its own reason. The fleet-wide pause
+  // lifted, V1 goes on and V2 stays paused; resumed all, both are idle again (ready for the
+  // next order), not paused.
+  ASSERT_EQ(droverctl(fleet, "pause-v2", {"pause", "V2", "--reason", "bumper check", "--domain", domain}, out, err),
+            0)
+      << out << err;
+  ASSERT_TRUE(wait_vehicle_state("V2", [](const msg::VehicleState& s) { return s.pause_reason() == "bumper check"; }));
   ASSERT_EQ(droverctl(fleet, "pause-all", {"pause", "--all", "--reason", "shift change", "--wait", "60", "--domain",
                                            domain},
                       out, err),
             0)
       << out << err;
   EXPECT_NE(out.find("vehicle 'V1' stands paused"), std::string::npos) << out;
+  EXPECT_NE(out.find("vehicle 'V2' already paused ('bumper check'): left as it is"), std::string::npos) << out;
   EXPECT_NE(out.find("vehicle 'V2' stands paused"), std::string::npos) << out;
-  for (const char* vehicle : {"V1", "V2"}) {
-    EXPECT_TRUE(wait_vehicle_state(vehicle, [](const msg::VehicleState& s) {
-      return s.paused() && s.pause_reason() == "shift change" && s.state() == msg::VEHICLE_PAUSED;
-    })) << vehicle << " not paused by pause --all";
-  }
+  EXPECT_TRUE(wait_vehicle_state("V1", [](const msg::VehicleState& s) {
+    return s.paused() && s.pause_reason() == "shift change" && s.state() == msg::VEHICLE_PAUSED;
+  })) << "V1 not paused by pause --all";
+  EXPECT_TRUE(wait_vehicle_state("V2", [](const msg::VehicleState& s) {
+    return s.paused() && s.pause_reason() == "bumper check" && s.state() == msg::VEHICLE_PAUSED;
+  })) << "V2's own pause changed by pause --all";
+  ASSERT_EQ(droverctl(fleet, "resume-shift", {"resume", "--all", "--reason", "shift change", "--domain", domain}, out,
+                      err),
+            0)
+      << out << err;
+  EXPECT_NE(out.find("vehicle 'V1' resumed"), std::string::npos) << out;
+  EXPECT_NE(out.find("vehicle 'V2' left paused ('bumper check')"), std::string::npos) << out;
+  EXPECT_TRUE(wait_vehicle_state(
+      "V1", [](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
+      << "V1 resumed with nothing to do is not idle";
   ASSERT_EQ(droverctl(fleet, "resume-all", {"resume", "--all", "--domain", domain}, out, err), 0) << out << err;
-  for (const char* vehicle : {"V1", "V2"}) {
-    EXPECT_TRUE(wait_vehicle_state(
-        vehicle, [](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
-        << vehicle << " resumed with nothing to do is not idle";
-  }
+  EXPECT_NE(out.find("vehicle 'V2' resumed"), std::string::npos) << out;
+  EXPECT_NE(out.find("vehicle 'V1' not paused"), std::string::npos) << out;
+  EXPECT_TRUE(wait_vehicle_state(
+      "V2", [](const msg::VehicleState& s) { return !s.paused() && s.state() == msg::VEHICLE_IDLE; }))
+      << "V2 resumed with nothing to do is not idle";
   // A vehicle no logical agent serves: nobody answers.
   EXPECT_EQ(droverctl(fleet, "pause-nobody", {"pause", "V9", "--timeout", "1", "--domain", domain}, out, err), 3)
       << out << err;
