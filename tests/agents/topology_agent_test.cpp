@@ -193,10 +193,9 @@ class TopologyAgentTest : public ::testing::Test {
   }
 
   /// Waits until the agent's notice writer delivers to this tester, then forgets what it
-  /// delivered (as wait_for_event_delivery does for events; the notices come from another
-  /// writer, matched on its own): holds of agent "probe" on `entity`, far in the future,
-  /// that expire at once (the agent expires holds every 100 ms), until a
-  /// NOTICE_PREPARE_EXPIRED arrives.
+  /// delivered: holds of agent "probe" on `entity`, far in the future, that expire at once
+  /// (the agent expires holds every 100 ms), until a NOTICE_PREPARE_EXPIRED arrives. For
+  /// tests that assert notices and no events (the probe's own events may still arrive).
   void wait_for_notice_delivery(const std::string& entity) {
     constexpr TimeNs kFar = seconds_to_ns(1e6);
     const auto expired = [&](topology::RouteId route) {
@@ -220,7 +219,6 @@ class TopologyAgentTest : public ::testing::Test {
     ASSERT_TRUE(delivered) << "no reservation notice reached the tester";
     std::lock_guard guard(mutex_);
     notices_.clear();
-    events_.clear();
   }
 
   /// Waits until `condition` (called with the mutex held) holds. \return whether it did.
