@@ -98,7 +98,7 @@ int run_alarms(const AlarmsArguments& arguments) {
   std::mutex output;  // alarms arrive on the reader's thread
   bool write_failed = false;
   dds::ReaderOptions kept_and_new;
-  kept_and_new.qos = dds::TopicQos::log_reader();
+  kept_and_new.qos = logical_agent::alarm_reader_qos();
   auto reader = dds::Reader<msg::OperatorAlarm>::create(
       **participant, logical_agent::kAlarmTopic,
       [&](const msg::OperatorAlarm& alarm) {

@@ -30,7 +30,7 @@ Status TopologyAgent::watch_logical_agents() {
   const bool sweeping = options_.departed_after.count() > 0;
   if (sweeping) {
     auto alarms = dds::Writer<msg::OperatorAlarm>::create(*participant_, logical_agent::kAlarmTopic,
-                                                          dds::TopicQos::log_writer(logical_agent::kAlarmsKept));
+                                                          logical_agent::alarm_writer_qos());
     if (!alarms) return unexpected(alarms.error());
     alarm_writer_ = std::move(*alarms);
     auto holdings = dds::ServiceClient<msg::HoldingsRequest, msg::HoldingsReply>::create(*participant_,

@@ -262,7 +262,7 @@ TEST_F(DroverctlTest, AlarmsShowsTheKeptAlarmsThenFollowsNewOnesFromTheChosenSev
   auto agent = make_participant(kDomain, "V1");
   ASSERT_TRUE(agent);
   auto writer = dds::Writer<msg::OperatorAlarm>::create(*agent, logical_agent::kAlarmTopic,
-                                                      dds::TopicQos::log_writer(logical_agent::kAlarmsKept));
+                                                      logical_agent::alarm_writer_qos());
   ASSERT_TRUE(writer.has_value());
   const auto alarm = [](msg::AlarmSeverity severity, const std::string& text) {
     msg::OperatorAlarm a;

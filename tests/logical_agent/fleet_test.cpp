@@ -296,7 +296,7 @@ class FleetTest : public ::testing::Test {
         },
         // An agent's alarm may be raised before this reader matched it (a restored order
         // failing at start-up): its writer keeps it for us.
-        dds::ReaderOptions{dds::TopicQos::log_reader(), {}, {}});
+        dds::ReaderOptions{logical_agent::alarm_reader_qos(), {}, {}});
     ASSERT_TRUE(alarms.has_value());
     alarms_ = std::move(*alarms);
     // Holds are followed from the topology agent's events, which carry one serial order: the

@@ -104,7 +104,7 @@ Status LogicalAgent::start() {
   if (!vehicle) return unexpected(vehicle.error());
   vehicle_writer_ = std::move(*vehicle);
   auto alarms =
-      dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, dds::TopicQos::log_writer(kAlarmsKept));
+      dds::Writer<msg::OperatorAlarm>::create(*participant_, kAlarmTopic, alarm_writer_qos());
   if (!alarms) return unexpected(alarms.error());
   alarm_writer_ = std::move(*alarms);
   auto make_way = dds::Writer<msg::MakeWayRequest>::create(*participant_, kMakeWayTopic, dds::TopicQos::events());

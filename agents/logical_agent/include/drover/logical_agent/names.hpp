@@ -4,6 +4,8 @@
 
 #include <cstdint>
 
+#include "drover/dds/qos.hpp"
+
 namespace drover::logical_agent {
 
 /// Service drover/logical/order/{request,reply}: OrderRequest / OrderReply, addressed to
@@ -20,11 +22,14 @@ inline constexpr const char* kPauseService = "pause";
 inline constexpr const char* kOrderProgressTopic = "drover/logical/order_progress";
 /// State topic of VehicleState, keyed on the vehicle id.
 inline constexpr const char* kVehicleStateTopic = "drover/logical/vehicle";
-/// Event log topic of OperatorAlarm (dds::TopicQos::log_writer(kAlarmsKept) and
-/// log_reader()): a reader that matches an agent late still gets its recent alarms.
+/// Event log topic of OperatorAlarm: a reader that matches an agent late still gets its
+/// recent alarms. Every writer and reader uses alarm_writer_qos() / alarm_reader_qos() (a
+/// VOLATILE writer would not match the TRANSIENT_LOCAL readers).
 inline constexpr const char* kAlarmTopic = "drover/operator/alarm";
 /// How many of its latest alarms each writer keeps for readers that match later.
 inline constexpr std::int32_t kAlarmsKept = 100;
+inline dds::TopicQos alarm_writer_qos() { return dds::TopicQos::log_writer(kAlarmsKept); }
+inline dds::TopicQos alarm_reader_qos() { return dds::TopicQos::log_reader(); }
 /// Event topic of MakeWayRequest (RELIABLE + VOLATILE + KEEP_ALL), read filtered on `vehicle`.
 inline constexpr const char* kMakeWayTopic = "drover/logical/make_way";
 
