@@ -382,7 +382,8 @@ class FleetTest : public ::testing::Test {
       if (other == status.vehicle_id) continue;
       // Only footprints of about the same moment: each vehicle's statuses arrive on a reader
       // thread of their own, and one that lags would show a vehicle where it no longer is.
-      // Both report every 0.2 s (shared clock), so an overlap that lasts is still compared.
+      // Both report every 0.2 s (shared clock), so an overlap that lasts is still compared
+      // (not with a vehicle whose RAN went silent: no test here drives into one).
       if (std::abs(status.time - other_status.time) > kSameMoment) continue;
       const double area = topology::footprint_overlap_area(status.footprint, other_status.footprint);
       if (area > 1e-6) {
