@@ -4,6 +4,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
@@ -94,13 +95,50 @@ TEST_F(DroverctlTopologyTest, LockHitsAReservationAndNotifiesItsOwnerTimelineSho
       dds::ReaderOptions{dds::TopicQos::events(), "agent = %0", {"'v1'"}});
   ASSERT_TRUE(reader.has_value());
   ASSERT_TRUE((*reader)->wait_for_writers(1, kDiscoveryTimeout));
-
-  // v1 reserves a during [1000, 5000) (with its shadow on a-b).
   auto prepare = dds::ServiceClient<msg::ReservePrepareRequest, msg::ReservePrepareReply>::create(
       *participant_, "topology", "reserve_prepare");
   auto commit = dds::ServiceClient<msg::ReserveCommitRequest, msg::StatusReply>::create(*participant_, "topology",
                                                                                       "reserve_commit");
   ASSERT_TRUE(prepare && commit);
+
+  // Our reader matching the agent's notice writer does not mean the writer matched our
+  // reader, and a notice written in between is lost: holds of v1 on b, far in the future and
+  // expiring at once (each a window and route of its own), until a NOTICE_PREPARE_EXPIRED
+  // reaches v1.
+  const auto probe_expired = [&] {
+    return std::any_of(notices.begin(), notices.end(),
+                       [](const msg::ReservationNotice& n) { return n.kind() == msg::NOTICE_PREPARE_EXPIRED; });
+  };
+  bool delivered = false;
+  for (std::uint64_t probe = 100; probe < 120 && !delivered; ++probe) {
+    msg::ReservePrepareRequest hold;
+    hold.agent("v1");
+    hold.route(probe);
+    for (const char* entity : {"b", "a-b"}) {  // b and its shadow on a-b, as for a below
+      msg::Reservation item;
+      item.agent("v1");
+      item.route(probe);
+      item.step(0);
+      item.entity(entity);
+      item.origin("b");
+      item.window().start(seconds_to_ns(1e6) + static_cast<TimeNs>(probe) * 10);
+      item.window().end(item.window().start() + 1);
+      hold.items().push_back(item);
+    }
+    hold.expires_at(SharedClock::wall().now());
+    auto held = (*prepare)->call(hold, kDiscoveryTimeout);
+    ASSERT_TRUE(held.has_value()) << held.error().message;
+    ASSERT_EQ(held->error().code(), msg::ERROR_NONE) << held->error().message();
+    std::unique_lock lock(mutex);
+    delivered = changed.wait_for(lock, 1s, probe_expired);
+  }
+  ASSERT_TRUE(delivered) << "no reservation notice reached v1";
+  {
+    std::lock_guard lock(mutex);
+    notices.clear();
+  }
+
+  // v1 reserves a during [1000, 5000) (with its shadow on a-b).
   msg::ReservePrepareRequest request;
   request.agent("v1");
   request.route(3);
