@@ -3,9 +3,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <future>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -13,6 +17,8 @@
 
 #include "diagnostics.h"
 #include "drover/dds/service_client.hpp"
+#include "drover/dds/service_server.hpp"
+#include "drover/dds/writer.hpp"
 #include "drover/dds/service_topics.hpp"
 #include "tests/agents/dds_test_support.hpp"
 
@@ -21,6 +27,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using PingClient = dds::ServiceClient<msg::PingRequest, msg::PingReply>;
+using PingServer = dds::ServiceServer<msg::PingRequest, msg::PingReply>;
 
 msg::PingRequest ping(const std::string& text, std::vector<uint8_t> payload = {}) {
   msg::PingRequest request;
@@ -225,6 +232,104 @@ TEST_F(ServiceTest, RequestsGoToTheNamedServerOrToEachServerInTurn) {
   ASSERT_FALSE(unknown.has_value());
   EXPECT_NE(unknown.error().message.find("no server 'echo-c' for service"), std::string::npos)
       << unknown.error().message;
+}
+
+// An echo server in the test process that records what each reply's send returned.
+class RecordingServer {
+ public:
+  RecordingServer(dds::Participant& participant, std::chrono::milliseconds reply_match_timeout) {
+    auto server = PingServer::create(
+        participant, "diagnostics", "ping",
+        [this](const msg::PingRequest& request, dds::ReplyHandle<msg::PingReply> handle) {
+          msg::PingReply reply;
+          reply.text(request.text());
+          Status sent = handle.send(std::move(reply));
+          std::lock_guard lock(mutex_);
+          sends_.emplace_back(request.text(), std::move(sent));
+          changed_.notify_all();
+        },
+        dds::ServerOptions{reply_match_timeout});
+    EXPECT_TRUE(server.has_value()) << (server ? "" : server.error().message);
+    if (server) server_ = std::move(*server);
+  }
+  bool ok() const { return server_ != nullptr; }
+
+  /// The outcome of sending the reply to the request with text `text`, once known.
+  std::optional<Status> send_outcome(const std::string& text) {
+    std::unique_lock lock(mutex_);
+    std::optional<Status> found;
+    changed_.wait_for(lock, kDiscoveryTimeout, [&] {
+      for (const auto& [sent_text, status] : sends_) {
+        if (sent_text == text) found = status;
+      }
+      return found.has_value();
+    });
+    return found;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<std::pair<std::string, Status>> sends_;
+  std::unique_ptr<PingServer> server_;  // last: its handler stops before the rest goes
+};
+
+// One agent may have several clients of one service (a RAN client per vehicle, say). A
+// reply must wait for the reply reader of the client that asked: were it written once any
+// reader of the agent matched, it would be lost to a client whose reader the server has
+// not matched yet.
+TEST_F(ServiceTest, AReplyWaitsForTheReplyReaderOfTheClientThatAsked) {
+  constexpr std::uint32_t kDomain = 19;
+  auto server_participant = make_participant(kDomain, "strict-server");
+  ASSERT_NE(server_participant, nullptr);
+  RecordingServer server(*server_participant, 500ms);
+  ASSERT_TRUE(server.ok());
+
+  auto participant = make_participant(kDomain, "many-clients");
+  ASSERT_NE(participant, nullptr);
+  auto first = make_client(*participant);
+  ASSERT_NE(first, nullptr);
+  auto answered = first->call(ping("first"), kDiscoveryTimeout);  // its reader is matched now
+  ASSERT_TRUE(answered.has_value()) << answered.error().message;
+  EXPECT_NE(answered->header().reply_reader(), 0u);  // the SDK names its reply reader
+
+  // A request naming a reply reader that does not exist: another reader of the agent is
+  // matched, yet the reply is not written, and its send says why.
+  auto raw = dds::Writer<msg::PingRequest>::create(*participant, "drover/diagnostics/ping/request",
+                                                    dds::TopicQos::service());
+  ASSERT_TRUE(raw.has_value()) << raw.error().message;
+  ASSERT_TRUE((*raw)->wait_for_readers(1, kDiscoveryTimeout));
+  msg::PingRequest to_nobody = ping("to a reader nobody has");
+  to_nobody.header().requester("many-clients");
+  to_nobody.header().reply_reader(0x00ffff07);
+  ASSERT_TRUE((*raw)->write(to_nobody).has_value());
+  auto unsent = server.send_outcome("to a reader nobody has");
+  ASSERT_TRUE(unsent.has_value());
+  ASSERT_FALSE(unsent->has_value());
+  EXPECT_EQ(unsent->error().code, ErrorCode::timeout);
+  EXPECT_NE(unsent->error().message.find("its reply reader did not match within 500 ms"), std::string::npos)
+      << unsent->error().message;
+
+  // A request that names no reply reader (a client not built on the SDK) is answered once
+  // any reader of its agent is matched: the first client gets it and sets it aside.
+  msg::PingRequest unnamed = ping("no reader named");
+  unnamed.header().requester("many-clients");
+  ASSERT_TRUE((*raw)->write(unnamed).has_value());
+  auto sent = server.send_outcome("no reader named");
+  ASSERT_TRUE(sent.has_value());
+  EXPECT_TRUE(sent->has_value()) << sent->error().message;
+
+  // Clients made and used at once, next to the first one, each get their reply.
+  for (int k = 0; k < 10; ++k) {
+    auto next = make_client(*participant);
+    ASSERT_NE(next, nullptr);
+    auto reply = next->call(ping("next " + std::to_string(k)), kDiscoveryTimeout);
+    ASSERT_TRUE(reply.has_value()) << reply.error().message;
+    EXPECT_EQ(reply->text(), "next " + std::to_string(k));
+    auto outcome = server.send_outcome("next " + std::to_string(k));
+    ASSERT_TRUE(outcome.has_value());
+    EXPECT_TRUE(outcome->has_value()) << outcome->error().message;
+  }
 }
 
 TEST(ServiceTopicsTest, NamesFollowTheConvention) {

@@ -44,6 +44,7 @@ Result<std::unique_ptr<ClientCore>> ClientCore::create(Participant& participant,
   if (!reader) return unexpected(reader.error());
   {
     std::lock_guard lock(core->state_mutex_);
+    core->reply_reader_id_ = (*reader)->guid().entityId.to_uint32();
     core->reply_reader_ = std::move(*reader);
   }
 

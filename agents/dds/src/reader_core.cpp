@@ -118,17 +118,17 @@ bool ReaderCore::matched(const GuidPrefix_t& participant) const {
 
 std::vector<GuidPrefix_t> ReaderCore::matched_participants() const {
   std::lock_guard lock(match_mutex_);
-  return matched_.all();
+  return matched_.participants();
 }
 
 std::size_t ReaderCore::matched_writers() const {
   std::lock_guard lock(match_mutex_);
-  return matched_.endpoints();
+  return matched_.size();
 }
 
 bool ReaderCore::wait_for_writers(std::size_t count, std::chrono::milliseconds timeout) const {
   std::unique_lock lock(match_mutex_);
-  return match_changed_.wait_for(lock, timeout, [&] { return matched_.endpoints() >= count; });
+  return match_changed_.wait_for(lock, timeout, [&] { return matched_.size() >= count; });
 }
 
 }  // namespace drover::dds::detail

@@ -39,7 +39,10 @@ void ReplyChannel::notify_match_change() {
 Status ReplyChannel::write(void* reply, const ReplyTarget& target) {
   std::unique_lock lock(mutex_);
   const bool matched = match_changed_.wait_for(lock, match_timeout_, [&] {
-    return writer_ == nullptr || writer_->matched(target.requester_participant);
+    if (writer_ == nullptr) return true;
+    const auto& reader = target.reply_reader;
+    return reader.entityId == eprosima::fastrtps::rtps::c_EntityId_Unknown ? writer_->matched(reader.guidPrefix)
+                                                                           : writer_->matched(reader);
   });
   if (writer_ == nullptr) {
     return fail(ErrorCode::unavailable,

@@ -66,19 +66,24 @@ bool WriterCore::matched(const GuidPrefix_t& participant) const {
   return matched_.contains(participant);
 }
 
+bool WriterCore::matched(const eprosima::fastrtps::rtps::GUID_t& reader) const {
+  std::lock_guard lock(mutex_);
+  return matched_.contains(reader);
+}
+
 std::vector<GuidPrefix_t> WriterCore::matched_participants() const {
   std::lock_guard lock(mutex_);
-  return matched_.all();
+  return matched_.participants();
 }
 
 std::size_t WriterCore::matched_readers() const {
   std::lock_guard lock(mutex_);
-  return matched_.endpoints();
+  return matched_.size();
 }
 
 bool WriterCore::wait_for_readers(std::size_t count, std::chrono::milliseconds timeout) const {
   std::unique_lock lock(mutex_);
-  return matched_changed_.wait_for(lock, timeout, [&] { return matched_.endpoints() >= count; });
+  return matched_changed_.wait_for(lock, timeout, [&] { return matched_.size() >= count; });
 }
 
 void WriterCore::on_publication_matched(fdds::DataWriter*,

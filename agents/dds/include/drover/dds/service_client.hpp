@@ -38,7 +38,7 @@ class ServiceClient {
 
   /// Sends `request` to the server `responder` (an agent id; empty: any server, taken in
   /// turn when several serve) and waits for its reply. Sets request.header: requester =
-  /// this agent, responder = the chosen server.
+  /// this agent, responder = the chosen server, reply_reader = this client's reply reader.
   /// \param timeout bounds the whole call: waiting for a server, then for the reply.
   /// \return the reply (whose `error` member carries the server's verdict), or
   ///         timeout "no server ... matched within ..." (nobody serves), or
@@ -50,6 +50,7 @@ class ServiceClient {
     if (!server) return unexpected(std::move(server).error());
     request.header().requester(participant_.agent_id());
     request.header().responder(server->name);
+    request.header().reply_reader(core_->reply_reader_id());
     auto reply = core_->send(&request, *server, deadline, timeout);
     if (!reply) return unexpected(std::move(reply).error());
     return std::move(*static_cast<Rep*>(reply->get()));

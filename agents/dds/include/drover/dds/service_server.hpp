@@ -55,6 +55,7 @@ class ReplyHandle {
     auto channel = std::move(channel_);
     reply.header().requester(target_.requester);
     reply.header().responder(responder_);
+    reply.header().reply_reader(target_.reply_reader.entityId.to_uint32());
     return channel->write(&reply, target_);
   }
 
@@ -109,8 +110,9 @@ class ServiceServer {
           const Req& request = *static_cast<const Req*>(sample);
           const std::string& responder = request.header().responder();
           if (!responder.empty() && responder != self_id) return;  // addressed to another server
-          detail::ReplyTarget target{info.sample_identity, info.sample_identity.writer_guid().guidPrefix,
-                                     request.header().requester()};
+          const eprosima::fastrtps::rtps::GUID_t reply_reader(info.sample_identity.writer_guid().guidPrefix,
+                                                              request.header().reply_reader());
+          detail::ReplyTarget target{info.sample_identity, reply_reader, request.header().requester()};
           handler(request, ReplyHandle<Rep>(channel, std::move(target), self_id));
         });
     if (!core) return unexpected(core.error());

@@ -68,6 +68,8 @@ class ClientCore {
 
   ClientStats stats() const;
   const std::string& service_name() const noexcept { return topics_.name; }
+  /// This client's reply reader as RequestHeader.reply_reader names it (its entity id).
+  std::uint32_t reply_reader_id() const noexcept { return reply_reader_id_; }
 
  private:
   struct Call {
@@ -93,6 +95,7 @@ class ClientCore {
   std::map<eprosima::fastrtps::rtps::SequenceNumber_t, std::shared_ptr<void>> early_replies_;
   eprosima::fastrtps::rtps::SequenceNumber_t last_registered_;
   eprosima::fastrtps::rtps::GUID_t writer_guid_;
+  std::uint32_t reply_reader_id_ = 0;
   std::uint64_t next_server_ = 0;
   ClientStats stats_;
 

@@ -19,7 +19,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include "drover/common/result.hpp"
-#include "drover/dds/detail/matched_participants.hpp"
+#include "drover/dds/detail/matched_endpoints.hpp"
 #include "drover/dds/detail/serial_executor.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/qos.hpp"
@@ -71,6 +71,7 @@ class ReaderCore final : private eprosima::fastdds::dds::DataReaderListener {
   /// Waits until at least `count` writers are matched. \return whether they are.
   bool wait_for_writers(std::size_t count, std::chrono::milliseconds timeout) const;
 
+  const eprosima::fastrtps::rtps::GUID_t& guid() const { return reader_->guid(); }
   const std::string& topic_name() const noexcept { return spec_.topic; }
 
  private:
@@ -99,7 +100,7 @@ class ReaderCore final : private eprosima::fastdds::dds::DataReaderListener {
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   mutable std::mutex match_mutex_;
   mutable std::condition_variable match_changed_;
-  MatchedParticipants matched_;
+  MatchedEndpoints matched_;
 };
 
 }  // namespace drover::dds::detail

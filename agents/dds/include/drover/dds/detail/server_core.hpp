@@ -21,10 +21,12 @@
 
 namespace drover::dds::detail {
 
-/// Where a reply goes: the request it answers and the participant that sent it.
+/// Where a reply goes: the request it answers and the reader that waits for it.
 struct ReplyTarget {
   eprosima::fastrtps::rtps::SampleIdentity request;
-  eprosima::fastrtps::rtps::GuidPrefix_t requester_participant;
+  /// The requester's reply reader; its entity id is unknown when the request did not name
+  /// it (RequestHeader.reply_reader 0), and then any reader of its participant will do.
+  eprosima::fastrtps::rtps::GUID_t reply_reader;
   std::string requester;  ///< the requester's agent id, for messages
 };
 

@@ -16,7 +16,7 @@
 #include <fastdds/rtps/common/WriteParams.h>
 
 #include "drover/common/result.hpp"
-#include "drover/dds/detail/matched_participants.hpp"
+#include "drover/dds/detail/matched_endpoints.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/qos.hpp"
 
@@ -47,7 +47,10 @@ class WriterCore final : private eprosima::fastdds::dds::DataWriterListener {
   ///         it already), or io when Fast DDS could not.
   Status retire(void* sample);
 
+  /// Whether any reader of `participant` is matched.
   bool matched(const eprosima::fastrtps::rtps::GuidPrefix_t& participant) const;
+  /// Whether the reader `reader` is matched.
+  bool matched(const eprosima::fastrtps::rtps::GUID_t& reader) const;
   std::vector<eprosima::fastrtps::rtps::GuidPrefix_t> matched_participants() const;
   std::size_t matched_readers() const;
   /// Waits until at least `count` readers are matched. \return whether they are.
@@ -67,7 +70,7 @@ class WriterCore final : private eprosima::fastdds::dds::DataWriterListener {
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   mutable std::mutex mutex_;
   mutable std::condition_variable matched_changed_;
-  MatchedParticipants matched_;
+  MatchedEndpoints matched_;
 };
 
 }  // namespace drover::dds::detail
