@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "agents/cli/number_checks.hpp"
+#include "agents/cli/text_checks.hpp"
 #include "drover/topology/topology_builder.hpp"
 
 namespace drover::cli {
@@ -19,14 +20,6 @@ enum ExitCode : int {
   kExitBadInput = 2,    ///< bad usage or invalid input
   kExitNoAnswer = 3,    ///< no agent answered
 };
-
-/// The option's text must not be empty (an empty file name would be reported as a file
-/// named "", which no message makes clear).
-inline CLI::Validator non_empty() {
-  return CLI::Validator(
-      [](std::string& text) { return text.empty() ? std::string("must not be empty") : std::string(); },
-      "");
-}
 
 /// Prints every problem found in `file` as "error: FILE:WHERE: WHAT" on standard error.
 /// \return kExitBadInput, the exit code of a tool whose input file was refused.

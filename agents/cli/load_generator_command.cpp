@@ -120,15 +120,18 @@ void add_load_generator_command(CLI::App& app, CommandContext& context) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--station", arguments->generator.stations,
-                      "A station orders may use (repeatable; default: every vertex of kind station)");
+                      "A station orders may use (repeatable; default: every vertex of kind station)")
+      ->check(identifier());
   command->add_option("--vehicle", arguments->generator.vehicles,
-                      "A vehicle to serve (repeatable; default: every vehicle that reports its state)");
+                      "A vehicle to serve (repeatable; default: every vehicle that reports its state)")
+      ->check(identifier());
   command->add_option("--seed", arguments->generator.seed, "Random seed (default 1)")
       ->transform(whole_in(0, kLargestWholeOption));
   command->add_option("--max-orders", arguments->generator.max_orders,
                       "Stop sending after this many orders (default 0: never)")
       ->transform(whole_in(0, kLargestWholeOption));
-  command->add_option("--id", arguments->agent_id, "Agent id; orders are named <id>-<n> (default load-generator)");
+  command->add_option("--id", arguments->agent_id, "Agent id; orders are named <id>-<n> (default load-generator)")
+      ->check(identifier());
   command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);

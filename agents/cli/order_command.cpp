@@ -216,12 +216,13 @@ void add_order_command(CLI::App& app, CommandContext& context) {
   auto* order = app.add_subcommand("order", "Transport orders of the logical agents");
   order->require_subcommand(1);
   auto* send_command = order->add_subcommand("send", "Send an order to one vehicle's logical agent");
-  send_command->add_option("vehicle", arguments->vehicle, "The vehicle id")->required();
+  send_command->add_option("vehicle", arguments->vehicle, "The vehicle id")->required()->check(cli::identifier());
   send_command->add_option("destinations", arguments->destinations,
                            "LOCATION:OPERATION, in execution order (operation NOP, load, unload, charge, "
                            "park or a custom action)")
       ->required();
-  send_command->add_option("--name", arguments->name, "The order's unique name (default: <vehicle>-<time>)");
+  send_command->add_option("--name", arguments->name, "The order's unique name (default: <vehicle>-<time>)")
+      ->check(cli::identifier());
   send_command->add_option("--wait", arguments->wait_seconds,
                            "Also wait up to S seconds for the order to finish (exit 1 if it fails)")
       ->transform(cli::non_negative());
@@ -231,7 +232,7 @@ void add_order_command(CLI::App& app, CommandContext& context) {
   auto withdrawal = std::make_shared<WithdrawArguments>();
   auto* withdraw_command = order->add_subcommand(
       "withdraw", "Withdraw an order: a queued one at once, a running one once the vehicle stands on a vertex");
-  withdraw_command->add_option("vehicle", withdrawal->vehicle, "The vehicle id")->required();
+  withdraw_command->add_option("vehicle", withdrawal->vehicle, "The vehicle id")->required()->check(cli::identifier());
   withdraw_command->add_option("order", withdrawal->order, "The order's name")->required();
   withdraw_command->add_option("--reason", withdrawal->reason, "Why (shown in the order's progress)");
   withdraw_command->add_option("--wait", withdrawal->wait_seconds,

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/cli/agent_discovery.hpp"
+#include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/cli/table.hpp"
@@ -121,7 +122,7 @@ void add_orders_command(CLI::App& app, CommandContext& context) {
   auto* command = app.add_subcommand(
       "orders", "The orders the logical agents know: queued, running and the ended ones they remember, with progress");
   add_dds_tool_options(*command, arguments->dds, 2.0);
-  command->add_option("--vehicle", arguments->vehicle, "Only the orders of this vehicle");
+  command->add_option("--vehicle", arguments->vehicle, "Only the orders of this vehicle")->check(cli::identifier());
   command->add_flag("--json", arguments->json, "Print a JSON array instead of a table");
   command->callback([arguments, &context] { context.exit_code = run_orders(*arguments); });
 }

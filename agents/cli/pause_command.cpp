@@ -195,7 +195,7 @@ void add_pause_command(CLI::App& app, CommandContext& context) {
   auto paused = std::make_shared<PauseArguments>();
   auto* pause = app.add_subcommand(
       "pause", "Pause a vehicle, or all: it stops at the next vertex it can and begins nothing new until resumed");
-  pause->add_option("vehicle", paused->vehicle, "The vehicle id");
+  pause->add_option("vehicle", paused->vehicle, "The vehicle id")->check(cli::identifier());
   pause->add_flag("--all", paused->all, "Every vehicle whose logical agent is alive (those paused already are left as they are)");
   pause->add_option("--reason", paused->reason, "Why (shown in droverctl vehicles)");
   pause->add_option("--wait", paused->wait_seconds,
@@ -206,7 +206,7 @@ void add_pause_command(CLI::App& app, CommandContext& context) {
 
   auto resumed = std::make_shared<PauseArguments>();
   auto* resume = app.add_subcommand("resume", "Resume a paused vehicle, or all");
-  resume->add_option("vehicle", resumed->vehicle, "The vehicle id");
+  resume->add_option("vehicle", resumed->vehicle, "The vehicle id")->check(cli::identifier());
   resume->add_flag("--all", resumed->all, "Every paused vehicle whose logical agent is alive");
   resume->add_option("--reason", resumed->reason, "With --all: only the vehicles paused for this reason");
   add_dds_tool_options(*resume, resumed->dds, 5.0);

@@ -74,7 +74,7 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<RoutingAgentArguments>();
   auto* command = app.add_subcommand(
       "routing-agent", "Serve routes (test and real) planned with CARP, reserved through the topology agents");
-  command->add_option("--id", arguments->agent_id, "Agent id (default: routing)");
+  command->add_option("--id", arguments->agent_id, "Agent id (default: routing)")->check(cli::identifier());
   command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);

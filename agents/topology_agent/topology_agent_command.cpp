@@ -84,12 +84,15 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--partition", arguments->partition,
-                      "Serve only the entities of this partition (default: all)");
+                      "Serve only the entities of this partition (default: all)")
+      ->check(cli::identifier());
   command->add_option("--db", arguments->journal_file,
-                      "SQLite journal: restored on start, written after every change (default: none)");
+                      "SQLite journal: restored on start, written after every change (default: none)")
+      ->check(cli::non_empty());
   command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--id", arguments->agent_id,
-                      "Agent id (default: topology-<partition>, or topology)");
+                      "Agent id (default: topology-<partition>, or topology)")
+      ->check(cli::identifier());
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   command->add_option("--departed-after", arguments->departed_after,

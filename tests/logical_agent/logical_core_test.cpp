@@ -79,6 +79,24 @@ TEST(OrderBook, ValidatesLocationsAgainstTheTopology) {
   EXPECT_FALSE(make_order(*world, OrderSpec{"", {{"left-4", "", {}}}, {}}));
 }
 
+// The name is the key of the order's progress on DDS: a name that cannot be published
+// must be refused before the order is queued or journaled, not when it starts.
+TEST(OrderBook, RefusesNamesThatCannotTravelAsDdsKeys) {
+  const auto world = h_crossing();
+  EXPECT_TRUE(make_order(*world, OrderSpec{std::string(255, 'n'), {{"left-4", "NOP", {}}}, {}}));
+  auto too_long = make_order(*world, OrderSpec{std::string(256, 'n'), {{"left-4", "NOP", {}}}, {}});
+  ASSERT_FALSE(too_long);
+  EXPECT_EQ(too_long.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(too_long.error().message.find("order name 'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...' is 256 bytes long"),
+            std::string::npos)
+      << too_long.error().message;
+  auto with_newline = make_order(*world, OrderSpec{"two\nlines", {{"left-4", "NOP", {}}}, {}});
+  ASSERT_FALSE(with_newline);
+  EXPECT_NE(with_newline.error().message.find("'two\\x0alines' contains the control character 0x0a at byte 3"),
+            std::string::npos)
+      << with_newline.error().message;
+}
+
 TEST(OrderBook, RunsOrdersInArrivalOrderThroughEveryDestination) {
   const auto world = h_crossing();
   std::vector<std::string> seen;

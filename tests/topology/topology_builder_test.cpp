@@ -181,6 +181,33 @@ TEST(TopologyBuilder, DiscFootprintsAreGeneratedWhenAsked) {
   EXPECT_FALSE(in_conflict(topology, "ab", "a"));
 }
 
+// Ids travel as DDS keys: one of 256 bytes or more could not be published, and a NUL
+// would cut it short on the wire, so that "left-1\0" and "left-1" became one entity.
+TEST(TopologyBuilder, RefusesIdsThatCannotTravelAsDdsKeys) {
+  TopologyBuilder builder("ids");
+  auto longest = vertex(std::string(255, 'v'), 0, 0);
+  longest.where = "vertices[0]";
+  builder.add_vertex(longest);
+  auto too_long = vertex(std::string(256, 'w'), 5, 0);
+  too_long.where = "vertices[1]";
+  builder.add_vertex(too_long);
+  auto with_nul = vertex(std::string("left-1\0", 7), 10, 0);
+  with_nul.where = "vertices[2]";
+  builder.add_vertex(with_nul);
+  auto with_tab = vertex("a\tb", 15, 0);
+  with_tab.where = "vertices[3]";
+  builder.add_vertex(with_tab);
+
+  const Diagnostics diagnostics = build_errors(std::move(builder));
+  const std::string all = dump(diagnostics);
+  EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[1].id", "is 256 bytes long, at most 255 are allowed")) << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[2].id", "contains the control character 0x00 at byte 6"))
+      << all;
+  EXPECT_TRUE(has_diagnostic(diagnostics, "vertices[3].id", "contains the control character 0x09 at byte 1"))
+      << all;
+  EXPECT_EQ(diagnostics.size(), 3u) << all;  // 255 bytes are fine
+}
+
 TEST(TopologyBuilder, ReportsEveryProblemWithWhereItIs) {
   TopologyBuilder builder("bad");
   auto a = vertex("a", 0, 0);

@@ -5,6 +5,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "drover/common/identifier.hpp"
 #include "drover/topology/conflicts.hpp"
 #include "drover/topology/footprints.hpp"
 
@@ -62,10 +63,10 @@ class Validator {
     }
   }
 
-  /// Registers an id; reports an empty or already used one.
+  /// Registers an id; reports one that breaks the identifier rule or is already used.
   void check_id(const std::string& id, const std::string& where) {
-    if (id.empty()) {
-      report(field_of(where, "id"), "must not be empty");
+    if (auto problem = identifier_problem(id)) {
+      report(field_of(where, "id"), *problem);
       return;
     }
     const auto [existing, inserted] = first_use_.emplace(id, where);

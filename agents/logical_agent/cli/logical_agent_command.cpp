@@ -107,19 +107,23 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
       "Run the logical agent of one vehicle until SIGINT/SIGTERM: it takes orders on "
       "drover/logical/order, drives its RAN (ran-<id>) along reserved routes and publishes order "
       "progress, vehicle state and operator alarms");
-  command->add_option("--id", arguments->vehicle_id, "The vehicle id (also the agent id)")->required();
+  command->add_option("--id", arguments->vehicle_id, "The vehicle id (also the agent id)")
+      ->required()
+      ->check(cli::identifier());
   command->add_option("--topology", arguments->topology_file, "Topology file (.json or .map)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--vehicle", arguments->vehicle_file,
                       "Vehicle profile JSON (max_speed, acceleration, deceleration, length, width, ...)")
       ->check(CLI::ExistingFile);
-  command->add_option("--ran-id", arguments->ran_agent, "The RAN's agent id (default: ran-<id>)");
+  command->add_option("--ran-id", arguments->ran_agent, "The RAN's agent id (default: ran-<id>)")
+      ->check(cli::identifier());
   command->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   command->add_option("--db", arguments->order_journal,
-                      "Order journal (SQLite; created if absent): orders survive a restart of the agent");
+                      "Order journal (SQLite; created if absent): orders survive a restart of the agent")
+      ->check(cli::non_empty());
   add_clock_options(*command, arguments->clock);
   command->add_option("--lookahead", arguments->lookahead, "Vertices allocated ahead of the vehicle (default 2)")
       ->transform(cli::whole_in(1, 1000));

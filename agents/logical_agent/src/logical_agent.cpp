@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "drover/common/identifier.hpp"
 #include "drover/dds/wire_error.hpp"
 #include "drover/logical_agent/names.hpp"
 #include "drover/ran_runner/names.hpp"
@@ -63,6 +64,7 @@ Result<std::unique_ptr<LogicalAgent>> LogicalAgent::create(std::shared_ptr<const
     return fail(ErrorCode::invalid_argument, "charge_to: " + *problem);
   }
   if (options.vehicle.id.empty()) options.vehicle.id = options.participant.agent_id;
+  if (auto valid = check_identifier(options.vehicle.id, "vehicle id"); !valid) return unexpected(valid.error());
   std::optional<OrderJournal> journal;
   std::vector<Order> stored;
   std::optional<std::string> pause;

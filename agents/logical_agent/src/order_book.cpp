@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "drover/common/identifier.hpp"
+
 namespace drover::logical_agent {
 
 const char* to_string(OrderState state) noexcept {
@@ -30,7 +32,7 @@ std::optional<ran::ActionCommand> operation_action(const Destination& destinatio
 }
 
 Result<Order> make_order(const topology::Topology& topology, const OrderSpec& spec) {
-  if (spec.name.empty()) return fail(ErrorCode::invalid_argument, "order: the name is empty");
+  if (auto valid = check_identifier(spec.name, "order name"); !valid) return unexpected(valid.error());
   if (spec.destinations.empty()) {
     return fail(ErrorCode::invalid_argument, "order '" + spec.name + "': no destination");
   }

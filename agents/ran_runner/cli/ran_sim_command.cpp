@@ -130,7 +130,7 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
       "ran-sim",
       "Run one simulated vehicle as a robot agent node (RAN) until SIGINT/SIGTERM: it executes "
       "moves and actions from drover/ran/command and publishes its status on drover/ran/status");
-  sim->add_option("--id", arguments->vehicle_id, "The vehicle id")->required();
+  sim->add_option("--id", arguments->vehicle_id, "The vehicle id")->required()->check(cli::identifier());
   sim->add_option("--topology", arguments->topology_file, "Topology file (.json or .map)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -139,7 +139,7 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
                   "Start heading in radians (default: the vertex orientation, else 0)")
       ->transform(cli::number_in(-1000, 1000));
   sim->add_option("--domain", arguments->domain_id, "DDS domain id")->transform(cli::whole_in(0, 232));
-  sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)");
+  sim->add_option("--agent-id", arguments->agent_id, "Agent id (default: ran-<id>)")->check(cli::identifier());
   sim->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*sim, arguments->clock);

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "drover/common/identifier.hpp"
 #include "drover/dds/service_server.hpp"
 #include "drover/dds/shutdown_signal.hpp"
 #include "drover/dds/wire_error.hpp"
@@ -136,8 +137,8 @@ RanRunner::RanRunner(SharedClock clock, VehicleDriver& driver, RanRunnerOptions 
 Result<std::unique_ptr<RanRunner>> RanRunner::create(dds::Participant& participant,
                                                      SharedClock clock, VehicleDriver& driver,
                                                      RanRunnerOptions options) {
-  if (options.vehicle_id.empty()) {
-    return fail(ErrorCode::invalid_argument, "ran runner: vehicle id is empty");
+  if (auto valid = check_identifier(options.vehicle_id, "ran runner: vehicle id"); !valid) {
+    return unexpected(valid.error());
   }
   if (options.status_period.count() <= 0) {
     return fail(ErrorCode::invalid_argument, "ran runner: status period must be positive");

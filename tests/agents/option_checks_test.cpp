@@ -1,7 +1,9 @@
-// The numeric option checks every tool shares: decimal only, plain messages, and the value
-// the option receives is the one checked.
+// The option checks every tool shares. Numbers: decimal only, plain messages, and the value
+// the option receives is the one checked. Texts: no empty value taken for "not given", and
+// ids that can travel as DDS keys.
 
 #include "agents/cli/number_checks.hpp"
+#include "agents/cli/text_checks.hpp"
 
 #include <cstdint>
 #include <string>
@@ -119,6 +121,25 @@ TEST(NumberChecks, NanosecondTimesOutOfRangeOrNotInDigitsAreRefused) {
     SCOPED_TRACE(text);
     EXPECT_NE(parse(text, exact_whole_in(0, INT64_MAX), ns).find("is not a number"), std::string::npos);
   }
+}
+
+TEST(TextChecks, IdsMustBeFitToTravelAsDdsKeys) {
+  std::string id;
+  EXPECT_EQ(parse("V1", identifier(), id), "");
+  EXPECT_EQ(id, "V1");
+  EXPECT_EQ(parse(std::string(255, 'v'), identifier(), id), "");
+  EXPECT_NE(parse("", identifier(), id).find("--n: must not be empty"), std::string::npos);
+  EXPECT_NE(parse(std::string(256, 'v'), identifier(), id).find("is 256 bytes long, at most 255 are allowed"),
+            std::string::npos);
+  EXPECT_NE(parse("V\n1", identifier(), id).find("'V\\x0a1' contains the control character 0x0a at byte 1"),
+            std::string::npos)
+      << parse("V\n1", identifier(), id);
+}
+
+TEST(TextChecks, AnEmptyTextIsRefusedNotTakenForNotGiven) {
+  std::string file;
+  EXPECT_EQ(parse("journal.db", non_empty(), file), "");
+  EXPECT_NE(parse("", non_empty(), file).find("--n: must not be empty"), std::string::npos);
 }
 
 }  // namespace
