@@ -860,6 +860,34 @@ TEST_F(FleetTest, ARanRestartedMidLoadFailsTheOrderInsteadOfLeavingItWaitingForE
   EXPECT_EQ(home->state(), msg::ORDER_FINISHED) << home->failure();
 }
 
+TEST_F(FleetTest, ARanRestartedMidMoveFailsTheOrderInsteadOfLeavingItDrivingForEver) {
+  constexpr std::uint32_t kDomain = 23;
+  Fleet fleet(kDomain, "ran-restart-mid-move");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-across"));
+  // The RAN goes down on the way to left-1 and comes back there at once, knowing no move:
+  // the move the agent waits for will never end (before, the order stayed running, the
+  // vehicle "driving" and standing, for ever).
+  ASSERT_NO_FATAL_FAILURE(fleet.crash("ran-V1"));
+  fleet.start_ran("V1", "left-1");
+  const auto across = wait_order("v1-across");
+  ASSERT_TRUE(across.has_value()) << "the order driving when the RAN restarted did not end";
+  EXPECT_EQ(across->state(), msg::ORDER_FAILED);
+  EXPECT_NE(across->failure().find("the move to 'left-1' is no longer reported by the RAN, which restarted"),
+            std::string::npos)
+      << across->failure();
+  {
+    std::lock_guard lock(seen_.mutex);
+    EXPECT_TRUE(alarm_seen(msg::ALARM_ERROR, "V1", "no longer reported by the RAN"));
+  }
+  // The vehicle works on from where its RAN came back.
+  ASSERT_EQ(send_order("V1", "v1-on", {{"left-4", "NOP"}}), "");
+  const auto on = wait_order("v1-on");
+  ASSERT_TRUE(on.has_value()) << "the next order did not end";
+  EXPECT_EQ(on->state(), msg::ORDER_FINISHED) << on->failure();
+}
+
 TEST_F(FleetTest, AVehicleHoldsItsVertexAndWorksThoughAPartitionItNeverUsesHasNoLiveOwner) {
   constexpr std::uint32_t kDomain = 47;
   Fleet fleet(kDomain, "silent-partition");

@@ -467,8 +467,22 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
   }
 }
 
+std::optional<std::size_t> LogicalAgent::forgotten_move(const ran::VehicleStatus& status,
+                                                        std::map<ran::CommandId, std::uint64_t>& listed_in) const {
+  for (const auto& [id, target] : pending_moves_) {
+    if (status.find_command(id) != nullptr) {
+      listed_in[id] = status.sequence;
+      continue;
+    }
+    const auto listed = listed_in.find(id);
+    if (listed != listed_in.end() && status.sequence < listed->second && !ended_commands_.contains(id)) return target;
+  }
+  return std::nullopt;
+}
+
 LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
   bool replan = false;
+  std::map<ran::CommandId, std::uint64_t> listed_in;  // see forgotten_move
   for (;;) {
     if (stopping_) {
       failure = "the logical agent is shutting down";
@@ -499,6 +513,17 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
         vertex_ = route_->step(target).entity;
         ended_commands_.erase(ended);
         pending_moves_.pop_front();
+      }
+      // Checked with the ends above under one lock: a status that ends a move records its
+      // end before it is the latest.
+      if (const auto lost = status_ ? forgotten_move(*status_, listed_in) : std::nullopt) {
+        failure = fmt::format("the move to '{}' is no longer reported by the RAN, which restarted: the vehicle "
+                              "stands where the RAN left it",
+                              topology_->id(route_->step(*lost).entity));
+        lock.unlock();
+        raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+        stop_vehicle();
+        return FollowResult::failed;
       }
     }
     const auto status = latest_status();
