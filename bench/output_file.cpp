@@ -39,11 +39,16 @@ Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
     }
   }
   std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
+  const auto kind = std::filesystem::status(path, error).type();
+  if (kind == std::filesystem::file_type::directory) {
     return fail(ErrorCode::invalid_argument, fmt::format("{}: is a directory", path.string()));
   }
+  // A device or a pipe is the reader's: renaming over it would put a plain file in its place.
+  const bool special = kind != std::filesystem::file_type::not_found && kind != std::filesystem::file_type::none &&
+                       kind != std::filesystem::file_type::regular;
+  if (special) partial = path;
   // A link at the temporary name is replaced, not written through to the file it names.
-  if (std::filesystem::is_symlink(std::filesystem::symlink_status(partial, error)) &&
+  if (!special && std::filesystem::is_symlink(std::filesystem::symlink_status(partial, error)) &&
       !std::filesystem::remove(partial, error)) {
     return fail(ErrorCode::io, fmt::format("{}: cannot replace the link {}: {}", path.string(),
                                            partial.string(), error.message()));
@@ -56,6 +61,7 @@ Result<OutputFile> OutputFile::open(const std::filesystem::path& path,
                                            partial.string(),
                                            errno != 0 ? std::strerror(errno) : "unknown error"));
   }
+  if (special) file.done_ = true;  // never removed: it is not ours
   return file;
 }
 
@@ -71,9 +77,9 @@ Status OutputFile::commit() {
   const bool written = static_cast<bool>(out_);
   out_.close();
   std::error_code error;
-  if (written && !out_.fail()) std::filesystem::rename(partial_, path_, error);
+  if (written && !out_.fail() && !direct()) std::filesystem::rename(partial_, path_, error);
   if (!written || out_.fail() || error) {
-    std::filesystem::remove(partial_, error);
+    if (!direct()) std::filesystem::remove(partial_, error);
     return fail(ErrorCode::io, fmt::format("{}: cannot write the file", path_.string()));
   }
   done_ = true;

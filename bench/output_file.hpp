@@ -18,7 +18,9 @@ class OutputFile {
   /// (a symbolic link there is replaced too, never written through).
   /// Fails, naming the file, when it cannot be created, when `path` is a directory, or when
   /// `path` or the temporary file is one of `inputs` (it would overwrite them). The file at
-  /// `path` is replaced, not written through: a link there becomes a plain file.
+  /// `path` is replaced, not written through: a link there becomes a plain file. Except
+  /// when `path` is no regular file (a device such as /dev/null, a pipe): that is written
+  /// directly, never replaced.
   static Result<OutputFile> open(const std::filesystem::path& path,
                                  const std::vector<std::filesystem::path>& inputs);
   OutputFile(OutputFile&& other) noexcept;
@@ -32,7 +34,9 @@ class OutputFile {
   Status commit();
 
  private:
+  /// Writes to `partial`, renamed to `path` on commit; `partial` == `path`: directly.
   OutputFile(std::filesystem::path path, std::filesystem::path partial);
+  bool direct() const { return partial_ == path_; }
   std::filesystem::path path_;
   std::filesystem::path partial_;
   std::ofstream out_;

@@ -138,7 +138,7 @@ int run(const LaunchArguments& arguments) {
   }
   std::unique_ptr<launcher::TraceWriter> trace;
   if (!arguments.trace_file.empty()) {
-    auto opened = launcher::TraceWriter::open(arguments.trace_file);
+    auto opened = launcher::TraceWriter::open(arguments.trace_file, {file->path, file->topology_file});
     if (!opened) {
       std::cerr << "error: " << opened.error().message << "\n";
       return kExitBadInput;
@@ -205,8 +205,12 @@ int run(const LaunchArguments& arguments) {
   figures.topology_events = statuses.topology_events;
   monitor->reset();
   participant->reset();
-  if (trace) trace->flush();
-  print_summary(*file, stopped_at - epoch, figures, *outcome, trace.get(), arguments.trace_file);
+  const Status traced = trace ? trace->flush() : Status{};
+  print_summary(*file, stopped_at - epoch, figures, *outcome, traced ? trace.get() : nullptr, arguments.trace_file);
+  if (!traced) {
+    std::cerr << "error: " << traced.error().message << "\n";
+    return kExitFailure;
+  }
   return outcome->any_failed() ? kExitFailure : kExitOk;
 }
 

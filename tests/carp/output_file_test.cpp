@@ -3,11 +3,13 @@
 #include "bench/output_file.hpp"
 
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace drover::bench {
@@ -92,6 +94,26 @@ TEST_F(OutputFileTest, ALinkAtThePartialNameIsReplacedNotWrittenThrough) {
   EXPECT_EQ(read("precious.txt"), "keep me\n");
   EXPECT_EQ(read("out.jsonl"), "new\n");
   EXPECT_FALSE(fs::is_symlink(path("out.jsonl")));
+}
+
+// `--paths /dev/null` or a pipe to another program: renaming the finished file over it
+// would put a plain file in place of the device (as root, of the system's /dev/null).
+TEST_F(OutputFileTest, APipeIsWrittenDirectlyNeverReplaced) {
+  const fs::path pipe = path("pipe");
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  auto reader = std::async(std::launch::async, [&] {
+    std::ifstream in(pipe);  // blocks until the writer opens the pipe
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  });
+  {
+    auto file = OutputFile::open(pipe, {});
+    ASSERT_TRUE(file.has_value()) << file.error().message;
+    file->stream() << "line 1\n";
+    EXPECT_TRUE(file->commit().has_value());
+  }
+  EXPECT_EQ(reader.get(), "line 1\n");
+  EXPECT_TRUE(fs::is_fifo(pipe)) << "the pipe was replaced";
+  EXPECT_FALSE(fs::exists(path("pipe.partial")));
 }
 
 TEST_F(OutputFileTest, ADirectoryIsRefused) {

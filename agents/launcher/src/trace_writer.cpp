@@ -5,12 +5,20 @@
 
 namespace drover::launcher {
 
-Result<std::unique_ptr<TraceWriter>> TraceWriter::open(const std::filesystem::path& path) {
+Result<std::unique_ptr<TraceWriter>> TraceWriter::open(const std::filesystem::path& path,
+                                                       const std::vector<std::filesystem::path>& inputs) {
+  for (const auto& input : inputs) {
+    std::error_code error;
+    if (std::filesystem::equivalent(path, input, error) && !error) {
+      return fail(ErrorCode::invalid_argument,
+                  "--trace: " + path.string() + " is an input of this launch; tracing would overwrite it");
+    }
+  }
   std::FILE* file = std::fopen(path.c_str(), "w");
   if (file == nullptr) {
     return fail(ErrorCode::io, "--trace: cannot create " + path.string() + ": " + std::strerror(errno));
   }
-  return std::unique_ptr<TraceWriter>(new TraceWriter(file));
+  return std::unique_ptr<TraceWriter>(new TraceWriter(file, path));
 }
 
 TraceWriter::~TraceWriter() { std::fclose(file_); }
@@ -22,13 +30,18 @@ void TraceWriter::write(TimeNs time, const std::string& type, const nlohmann::js
   for (const auto& [key, value] : fields.items()) line[key] = value;
   const std::string text = line.dump() + "\n";
   std::lock_guard lock(mutex_);
-  std::fwrite(text.data(), 1, text.size(), file_);
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() && write_error_ == 0) {
+    write_error_ = errno != 0 ? errno : EIO;
+  }
   ++lines_;
 }
 
-void TraceWriter::flush() {
+Status TraceWriter::flush() {
   std::lock_guard lock(mutex_);
-  std::fflush(file_);
+  if (std::fflush(file_) != 0 && write_error_ == 0) write_error_ = errno != 0 ? errno : EIO;
+  if (write_error_ == 0) return {};
+  return fail(ErrorCode::io, "--trace: cannot write " + path_.string() + ": " + std::strerror(write_error_) +
+                                 "; the trace is incomplete");
 }
 
 std::uint64_t TraceWriter::lines() const {
