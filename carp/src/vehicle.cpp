@@ -16,21 +16,27 @@ bool listed(const std::vector<std::string>& types, const std::string& type) {
 }  // namespace
 
 Status validate(const VehicleProfile& vehicle) {
+  // Physical bounds, not only signs: a vehicle that accelerates at 1e-19 m/s^2 needs
+  // longer than the clock can count to reach any speed, and its times would overflow.
   const struct {
     const char* name;
     double value;
-    bool zero_allowed;
+    double low;
+    double high;
+    const char* unit;
   } fields[] = {
-      {"max_speed", vehicle.max_speed, false},   {"acceleration", vehicle.acceleration, false},
-      {"deceleration", vehicle.deceleration, false}, {"length", vehicle.length, false},
-      {"width", vehicle.width, false},           {"payload", vehicle.payload, true},
+      {"max_speed", vehicle.max_speed, 0.001, 100.0, "m/s"},
+      {"acceleration", vehicle.acceleration, 0.001, 100.0, "m/s^2"},
+      {"deceleration", vehicle.deceleration, 0.001, 100.0, "m/s^2"},
+      {"length", vehicle.length, 0.001, 1000.0, "m"},
+      {"width", vehicle.width, 0.001, 1000.0, "m"},
+      {"payload", vehicle.payload, 0.0, 1e9, "kg"},
   };
   for (const auto& field : fields) {
-    const bool in_range = field.zero_allowed ? field.value >= 0 : field.value > 0;
-    if (!std::isfinite(field.value) || !in_range) {
-      return fail(ErrorCode::invalid_argument,
-                  fmt::format("vehicle '{}': {} must be {} and finite, got {}", vehicle.id,
-                              field.name, field.zero_allowed ? ">= 0" : "> 0", field.value));
+    if (!std::isfinite(field.value) || field.value < field.low || field.value > field.high) {
+      const std::string whose = vehicle.id.empty() ? std::string() : fmt::format("vehicle '{}': ", vehicle.id);
+      return fail(ErrorCode::invalid_argument, fmt::format("{}{} must be from {} to {} {}, got {}", whose, field.name,
+                                                           field.low, field.high, field.unit, field.value));
     }
   }
   return {};

@@ -7,16 +7,8 @@
 
 namespace drover::carp {
 
-Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& error) {
-    const auto syntax = json_syntax_error(text, error);
-    const std::string at = syntax.where.empty() ? where : where + ":" + syntax.where;
-    return fail(ErrorCode::parse, at + ": " + syntax.what);
-  }
-  if (!json.is_object()) return fail(ErrorCode::parse, where + ": a vehicle profile is a JSON object");
+Result<VehicleProfile> vehicle_profile_from_json(const nlohmann::json& json) {
+  if (!json.is_object()) return fail(ErrorCode::parse, "a vehicle profile is a JSON object");
   VehicleProfile vehicle;
   for (const auto& [key, value] : json.items()) {
     std::string* text_field = key == "id" ? &vehicle.id : key == "type" ? &vehicle.type : nullptr;
@@ -28,20 +20,32 @@ Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std:
                      : key == "payload"      ? &vehicle.payload
                                              : nullptr;
     if (text_field != nullptr) {
-      if (!value.is_string()) return fail(ErrorCode::parse, where + ": " + key + ": must be a string");
+      if (!value.is_string()) return fail(ErrorCode::parse, key + ": must be a string");
       *text_field = value.get<std::string>();
     } else if (number != nullptr) {
-      if (!value.is_number()) return fail(ErrorCode::parse, where + ": " + key + ": must be a number");
+      if (!value.is_number()) return fail(ErrorCode::parse, key + ": must be a number");
       *number = value.get<double>();
     } else {
-      return fail(ErrorCode::parse, where + ": " + key +
+      return fail(ErrorCode::parse, key +
                                         ": unknown field (known: id, type, max_speed, acceleration, "
                                         "deceleration, length, width, payload)");
     }
   }
-  if (auto valid = validate(vehicle); !valid) {
-    return fail(ErrorCode::invalid_argument, where + ": " + valid.error().message);
+  if (auto valid = validate(vehicle); !valid) return unexpected(valid.error());
+  return vehicle;
+}
+
+Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& error) {
+    const auto syntax = json_syntax_error(text, error);
+    const std::string at = syntax.where.empty() ? where : where + ":" + syntax.where;
+    return fail(ErrorCode::parse, at + ": " + syntax.what);
   }
+  auto vehicle = vehicle_profile_from_json(json);
+  if (!vehicle) return fail(vehicle.error().code, where + ": " + vehicle.error().message);
   return vehicle;
 }
 

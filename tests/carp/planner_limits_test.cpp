@@ -94,22 +94,31 @@ TEST(PlannerLimits, AFloorRaisedPastTheDeadlineEndsTheSearch) {
 
 TEST(PlannerLimits, AVehicleTooSlowForTheGraphIsRefusedNotPlannedAtTopSpeed) {
   World w(GridBuilder().corridor(3).build());
-  PlanRequest slow = request_to(w, "a", "0,0", {open_stop(w, "2,0")});
-  slow.vehicle.max_speed = 1e-12;  // a metre in 30 000 years
-  slow.vehicle.id = "snail";
-  const PlanError error = plan_error(w, slow);
-  EXPECT_EQ(error.reason, PlanFailure::invalid_request) << error.message;
-  EXPECT_TRUE(mentions(error, "vehicle 'snail' is too slow")) << error.message;
-  // Another vehicle of the same class (the traversal is shared) is named as itself.
-  slow.vehicle.id = "slug";
-  EXPECT_TRUE(mentions(plan_error(w, slow), "vehicle 'slug' is too slow"));
-
+  // Out of the profile's physical bounds: refused before any search.
+  PlanRequest snail = request_to(w, "a", "0,0", {open_stop(w, "2,0")});
+  snail.vehicle.max_speed = 1e-12;  // a metre in 30 000 years
+  snail.vehicle.id = "snail";
+  const PlanError out_of_bounds = plan_error(w, snail);
+  EXPECT_EQ(out_of_bounds.reason, PlanFailure::invalid_request) << out_of_bounds.message;
+  EXPECT_TRUE(mentions(out_of_bounds, "vehicle 'snail': max_speed must be from 0.001 to 100 m/s"))
+      << out_of_bounds.message;
   PlanRequest long_vehicle = request_to(w, "a", "0,0", {open_stop(w, "2,0")});
   long_vehicle.vehicle.length = 1e12;
   EXPECT_EQ(plan_error(w, long_vehicle).reason, PlanFailure::invalid_request);
 
-  FreePathSearch free(w.graph);
-  const auto path = free.find(slow.vehicle, w.at("0,0"), w.at("2,0"));
+  // Within bounds, but an edge's crawling speed limit makes the vehicle too slow for it.
+  World crawl(GridBuilder().corridor(3).cell(0, 1).edge(0, 0, 0, 1, EdgeOptions{.max_speed = 1e-12}).build());
+  PlanRequest slow = request_to(crawl, "a", "0,0", {open_stop(crawl, "2,0")});
+  slow.vehicle.id = "snail";
+  const PlanError error = plan_error(crawl, slow);
+  EXPECT_EQ(error.reason, PlanFailure::invalid_request) << error.message;
+  EXPECT_TRUE(mentions(error, "vehicle 'snail' is too slow")) << error.message;
+  // Another vehicle of the same class (the traversal is shared) is named as itself.
+  slow.vehicle.id = "slug";
+  EXPECT_TRUE(mentions(plan_error(crawl, slow), "vehicle 'slug' is too slow"));
+
+  FreePathSearch free(crawl.graph);
+  const auto path = free.find(slow.vehicle, crawl.at("0,0"), crawl.at("2,0"));
   ASSERT_FALSE(path.has_value());
   EXPECT_EQ(path.error().code, ErrorCode::invalid_argument) << path.error().message;
 

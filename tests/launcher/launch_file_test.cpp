@@ -210,6 +210,16 @@ TEST(LaunchFile, BadProfileFields) {
   EXPECT_NE(text.find("vehicle_profiles.y: must be an object"), std::string::npos) << text;
 }
 
+// A vehicle that would take longer than the clock counts to reach any speed: the planner
+// refuses it, so the file check does, before any logical agent starts.
+TEST(LaunchFile, ProfilesOutsideThePlannersBoundsAreRefused) {
+  const auto text = problems_of(R"({"topology": "topologies/loop.json",
+      "vehicle_profiles": {"slow": {"acceleration": 1e-19}}, "agents": [{"kind": "routing"}]})");
+  EXPECT_NE(text.find("vehicle_profiles.slow: acceleration must be from 0.001 to 100 m/s^2, got 1e-19"),
+            std::string::npos)
+      << text;
+}
+
 // What the agents would refuse at start, after the rest of the fleet started: a battery
 // fuller than it holds, orders without two distinct stations to go between.
 TEST(LaunchFile, BatteriesOverTheirCapacityAndTooFewStationsAreRefused) {

@@ -199,6 +199,20 @@ TEST_F(TimelineDelay, RejectsBadRequestsAndChangesNothing) {
   EXPECT_TRUE(set.delay("amy", 1, 2, 2).has_value());
 }
 
+// A delay the size of the clock's range pushes the routes behind it past the end of time
+// too: refused, with nothing changed, and no time computed on the way overflows (the
+// sanitized run of this test aborts on signed overflow).
+TEST_F(TimelineDelay, ADelayPushingOthersPastTheEndOfTimeIsRefused) {
+  ASSERT_TRUE(set.reserve("amy", 1, {at(2, 0, 10), at(3, 8, 20)}));
+  ASSERT_TRUE(set.reserve("bob", 1, {at(2, 10, 20), at(4, 18, 30)}));
+  const TimelineSet before = set;
+  const auto huge = set.delay("amy", 1, 2, std::numeric_limits<TimeNs>::max() - 5);
+  ASSERT_FALSE(huge.has_value());
+  EXPECT_EQ(huge.error().code, ErrorCode::invalid_argument);
+  EXPECT_NE(huge.error().message.find("past the end of time"), std::string::npos) << huge.error().message;
+  EXPECT_TRUE(set == before);
+}
+
 // check_delay, the I3 checker of the randomised test, must catch broken delays.
 TEST_F(TimelineDelay, TheCheckerCatchesBrokenDelays) {
   ASSERT_TRUE(set.reserve("amy", 1, {at(2, 0, 10), at(3, 8, 20)}));

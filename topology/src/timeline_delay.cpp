@@ -61,6 +61,12 @@ class RouteLevels {
   std::map<std::uint64_t, DurationNs> entries_;
 };
 
+/// `time` + `shift`, or kForever where that would pass the end of the TimeNs range.
+TimeNs shifted(TimeNs time, DurationNs shift) {
+  TimeNs sum = 0;
+  return __builtin_add_overflow(time, shift, &sum) ? kForever : sum;
+}
+
 /// The new window of `r` under its route's levels; nullopt when a time would reach
 /// kForever (or overflow).
 std::optional<Interval> moved_window(const Reservation& r, const RouteLevels& levels) {
@@ -168,7 +174,8 @@ Result<DelayReport> TimelineSet::delay(const AgentId& agent, RouteId route, Enti
           }
         }
       }
-      if (blocker_end > r.window.start + levels_of(r).at(r.step) &&
+      // Saturated at kForever: a delay past the end of time is refused below (moved_window).
+      if (blocker_end > shifted(r.window.start, levels_of(r).at(r.step)) &&
           levels[key_of(r)].raise(r.step, blocker_end - r.window.start)) {
         for (EntityIndex y : entities_of[key_of(r)]) {
           if (!queued[y]) {
@@ -178,8 +185,7 @@ Result<DelayReport> TimelineSet::delay(const AgentId& agent, RouteId route, Enti
         }
       }
       const RouteLevels& mine = levels_of(r);
-      const TimeNs end =
-          r.window.end == kForever ? kForever : r.window.end + mine.at(std::uint64_t{r.step} + 1);
+      const TimeNs end = r.window.end == kForever ? kForever : shifted(r.window.end, mine.at(std::uint64_t{r.step} + 1));
       seen.add(r.agent, end);
       if (r.origin == x) {
         seen_real.add(r.agent, end);

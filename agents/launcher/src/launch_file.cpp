@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/cli/number_checks.hpp"
+#include "drover/carp/vehicle_profile_json.hpp"
 #include "drover/common/clock.hpp"
 #include "drover/common/json_syntax.hpp"
 #include "drover/common/text_file.hpp"
@@ -300,6 +301,10 @@ class LaunchFileParser {
         if (std::find(kLogicalProfileFields.begin(), kLogicalProfileFields.end(), key) != kLogicalProfileFields.end()) {
           parsed.logical[key] = value;
         }
+      }
+      // The planner's bounds, checked here so that no logical agent is started to refuse it.
+      if (auto vehicle = carp::vehicle_profile_from_json(parsed.logical); !vehicle) {
+        checker_.problem(where, vehicle.error().message);
       }
       // The simulated vehicle starts with a full battery unless told otherwise, and never
       // with more than it holds.

@@ -6,10 +6,17 @@
 
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "drover/carp/vehicle.hpp"
 #include "drover/common/result.hpp"
 
 namespace drover::carp {
+
+/// Reads a profile from parsed JSON. \return the validated profile, or parse (not an
+///         object, a field of the wrong type, an unknown field) or invalid_argument (a value
+///         out of range), each naming the field ("acceleration: ...").
+Result<VehicleProfile> vehicle_profile_from_json(const nlohmann::json& json);
 
 /// Parses a profile from JSON text; `where` names the source in messages (a file name).
 /// \return the validated profile, or parse (not JSON, not an object, a field of the wrong
