@@ -64,6 +64,7 @@ int self_test() {
   driver.on_move(move_to("there", "P3", 3, 0), now);
   driver.on_action(ActionCommand{"pick", ActionKind::load, "", {}}, now);
   driver.on_move(move_to("back", "P0", 0, 0), now);
+  driver.on_move(move_to("there", "P3", 3, 0), now);  // sent again: never driven twice
   driver.on_move(move_to("outside", "Q", 0, 2), now);  // leaves the corridor: refused
   driver.on_action(ActionCommand{"charge", ActionKind::charge, "", {}}, now);  // unsupported
   while (!driver.idle() && now < seconds_to_ns(60)) {

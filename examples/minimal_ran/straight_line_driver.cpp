@@ -43,7 +43,9 @@ void StraightLineDriver::on_move(const MoveCommand& command, TimeNs now) {
   const double dx = command.target.x - planned_end_.x, dy = command.target.y - planned_end_.y;
   const double heading = std::hypot(dx, dy) > 0 ? std::atan2(dy, dx) : planned_end_.theta;
   const auto start = footprint_at(kOutline, Pose{planned_end_.x, planned_end_.y, heading});
-  if (auto valid = validate(command); !valid) {
+  if (status_.find_command(command.id) != nullptr) {
+    // Sent again (a retry): never done twice; its report stays the original's.
+  } else if (auto valid = validate(command); !valid) {
     reject(command.id, valid.error());
   } else if (area_outside(swept_by_translation(start, dx, dy), normalized_area(command.area)) >
              1e-4) {
@@ -57,7 +59,9 @@ void StraightLineDriver::on_move(const MoveCommand& command, TimeNs now) {
 
 void StraightLineDriver::on_action(const ActionCommand& command, TimeNs now) {
   advance(now);
-  if (auto valid = validate(command); !valid) {
+  if (status_.find_command(command.id) != nullptr) {
+    // Sent again (a retry): never done twice; its report stays the original's.
+  } else if (auto valid = validate(command); !valid) {
     reject(command.id, valid.error());
   } else if (command.kind == ActionKind::charge || command.kind == ActionKind::custom) {
     reject(command.id, {rejection_code::kUnsupportedAction, "this vehicle only loads and unloads"});
