@@ -1,6 +1,7 @@
 // `droverctl unlock LOCK_ID`: removes a lock. Lock ids are "<topology agent id>/<number>",
 // so the id names the agent to ask.
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -19,13 +20,19 @@ struct UnlockArguments {
 };
 
 int run_unlock(const UnlockArguments& arguments) {
+  // <agent id>/<number>, the number as the topology agent wrote it (no sign, no leading
+  // zero): "t/01" naming lock 1 would remove a lock that nobody named.
   const auto slash = arguments.lock_id.rfind('/');
-  if (slash == std::string::npos || slash == 0 || slash + 1 == arguments.lock_id.size()) {
+  const std::string agent = slash == std::string::npos ? std::string() : arguments.lock_id.substr(0, slash);
+  const std::string number = slash == std::string::npos ? std::string() : arguments.lock_id.substr(slash + 1);
+  const bool digits_only = !number.empty() && std::all_of(number.begin(), number.end(), [](char c) {
+    return c >= '0' && c <= '9';
+  });
+  if (!dds::validate_agent_id(agent) || !digits_only || (number.size() > 1 && number.front() == '0')) {
     std::cerr << "error: '" << arguments.lock_id
               << "' is not a lock id (lock ids are <topology agent id>/<number>, as droverctl lock printed)\n";
     return kExitBadInput;
   }
-  const std::string agent = arguments.lock_id.substr(0, slash);
   auto participant = open_tool_participant(arguments.dds);
   if (!participant) {
     std::cerr << "error: " << participant.error().message << "\n";

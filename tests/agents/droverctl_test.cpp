@@ -346,6 +346,25 @@ TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 2);
   EXPECT_NE(err.find("--duration"), std::string::npos) << err;
+
+  // An empty vehicle would address whichever logical agent answers first.
+  status = run_droverctl({"order", "send", "", "left-4:NOP"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("vehicle: must not be empty"), std::string::npos) << err;
+
+  status = run_droverctl({"order", "send", "V1", "left-4:NOP", "--name", std::string(256, 'n')}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("is 256 bytes long, at most 255 are allowed"), std::string::npos) << err;
+
+  // Lock ids as the topology agent writes them, or nothing is asked: "t/01" is not lock 1.
+  for (const std::string bad : {"topology/1x", "topology/2/3", "topology/01", "topology/", "/1"}) {
+    status = run_droverctl({"unlock", bad, "--timeout", "1"}, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 2) << bad;
+    EXPECT_NE(err.find("is not a lock id"), std::string::npos) << bad << ": " << err;
+  }
 }
 
 }  // namespace
