@@ -128,7 +128,9 @@ int run(const LaunchArguments& arguments) {
   const TimeNs epoch = file->epoch_ns.value_or(origin);
   auto clock = SharedClock::create_at_origin(epoch, file->time_factor, origin);
   if (!clock) {
-    std::cerr << "error: clock: " << clock.error().message << "\n";
+    // The epoch and time factor come from the file, or from --time-factor: name both.
+    std::cerr << "error: " << file->path.string() << ": epoch " << epoch << " ns with time factor "
+              << file->time_factor << " gives no usable shared clock: " << clock.error().message << "\n";
     return kExitBadInput;
   }
   auto executable = launcher::current_executable();
