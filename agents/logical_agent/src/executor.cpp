@@ -41,6 +41,20 @@ bool nobody_answered(const Error& error) {
 
 std::string seconds_text(DurationNs ns) { return fmt::format("{:.1f} s", ns_to_seconds(ns)); }
 
+/// Follows one command through the RAN's statuses, noting in `listed_in` the sequence of
+/// the latest status that lists it. A RAN lists a command until it ends (its end is kept in
+/// ended_commands_ as its status arrives). \return whether the RAN forgot it: `status` does
+/// not list it and its sequence went back below one that did (a RAN that started again
+/// counts from 1).
+bool forgotten_by_ran(const ran::VehicleStatus& status, const ran::CommandId& command,
+                      std::optional<std::uint64_t>& listed_in) {
+  if (status.find_command(command) != nullptr) {
+    listed_in = status.sequence;
+    return false;
+  }
+  return listed_in && status.sequence < *listed_in;
+}
+
 }  // namespace
 
 bool LogicalAgent::wait_event() {
@@ -468,21 +482,16 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
 }
 
 std::optional<std::size_t> LogicalAgent::forgotten_move(const ran::VehicleStatus& status,
-                                                        std::map<ran::CommandId, std::uint64_t>& listed_in) const {
+                                                        ListedIn& listed_in) const {
   for (const auto& [id, target] : pending_moves_) {
-    if (status.find_command(id) != nullptr) {
-      listed_in[id] = status.sequence;
-      continue;
-    }
-    const auto listed = listed_in.find(id);
-    if (listed != listed_in.end() && status.sequence < listed->second && !ended_commands_.contains(id)) return target;
+    if (forgotten_by_ran(status, id, listed_in[id]) && !ended_commands_.contains(id)) return target;
   }
   return std::nullopt;
 }
 
 LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
   bool replan = false;
-  std::map<ran::CommandId, std::uint64_t> listed_in;  // see forgotten_move
+  ListedIn listed_in;  // see forgotten_move
   for (;;) {
     if (stopping_) {
       failure = "the logical agent is shutting down";
@@ -905,12 +914,7 @@ Status LogicalAgent::await_action(const ran::CommandId& command, const std::stri
                                               ended->code + " " + ended->reason);
     }
     if (status) {
-      // A RAN lists a command until it ends, and its end is kept in ended_commands_ as its
-      // status arrives. A status without it whose sequence went back below one that listed
-      // it comes from a RAN that started again (a sink counts from 1) and forgot it.
-      if (status->find_command(command) != nullptr) {
-        listed_in = status->sequence;
-      } else if (listed_in && status->sequence < *listed_in) {
+      if (forgotten_by_ran(*status, command, listed_in)) {
         return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command +
                                                 "') is no longer reported by the RAN, which restarted: whether it "
                                                 "was done is unknown (check the vehicle)");

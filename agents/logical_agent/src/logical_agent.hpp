@@ -216,12 +216,13 @@ class LogicalAgent {
   Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience,
                   std::optional<RouteTracker> planned = std::nullopt);
   FollowResult follow(std::string& failure);
+  /// Per command, the sequence of the latest RAN status that listed it.
+  using ListedIn = std::map<ran::CommandId, std::optional<std::uint64_t>>;
   /// The target step of a pending move that the RAN forgot: listed in one of its statuses,
   /// then missing, without an end, from `status` whose sequence went back below that one
   /// (a RAN that started again counts from 1). Notes in `listed_in` the sequence of the
   /// latest status that listed each pending move. \pre mutex_ held
-  std::optional<std::size_t> forgotten_move(const ran::VehicleStatus& status,
-                                            std::map<ran::CommandId, std::uint64_t>& listed_in) const;
+  std::optional<std::size_t> forgotten_move(const ran::VehicleStatus& status, ListedIn& listed_in) const;
   /// Performs an action where the vehicle stands; `for_order`: the running order's operation
   /// (its command is recorded first, OrderBook::action_commanded). \return success or why
   /// it failed.
