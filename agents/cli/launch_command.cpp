@@ -41,16 +41,17 @@ struct LaunchArguments {
   std::string log_level = "warn";
 };
 
-/// The directory relative journal paths live in: the one given (created if missing), or a
-/// fresh temporary one that is removed at the end.
+/// The directory relative journal paths live in: the one given (created by ensure_exists
+/// when missing, so that a refused launch file leaves nothing behind), or a fresh temporary
+/// one that is removed at the end.
 class StateDirectory {
  public:
   static Result<StateDirectory> make(const std::string& given) {
     std::error_code error;
     if (!given.empty()) {
-      std::filesystem::create_directories(given, error);
+      auto path = std::filesystem::absolute(given, error);
       if (error) return fail(ErrorCode::io, "--state-dir " + given + ": " + error.message());
-      return StateDirectory(std::filesystem::absolute(given), false);
+      return StateDirectory(std::move(path), false);
     }
     std::string pattern = (std::filesystem::temp_directory_path(error) / "drover-launch-XXXXXX").string();
     if (error || ::mkdtemp(pattern.data()) == nullptr) {
@@ -66,6 +67,13 @@ class StateDirectory {
     if (temporary_) std::filesystem::remove_all(path_, ignored);
   }
   const std::filesystem::path& path() const noexcept { return path_; }
+  /// Creates the directory if it is missing. \return io naming it when that fails.
+  Status ensure_exists() const {
+    std::error_code error;
+    std::filesystem::create_directories(path_, error);
+    if (error) return fail(ErrorCode::io, "--state-dir " + path_.string() + ": " + error.message());
+    return {};
+  }
 
  private:
   StateDirectory(std::filesystem::path path, bool temporary) : path_(std::move(path)), temporary_(temporary) {}
@@ -153,6 +161,11 @@ int run(const LaunchArguments& arguments) {
                   {"time_factor", file->time_factor},
                   {"epoch", epoch},
                   {"clock_origin_unix_ns", origin}});
+  }
+  // Only now that every input is good: a refused launch leaves no directory behind.
+  if (auto exists = state_dir->ensure_exists(); !exists) {
+    std::cerr << "error: " << exists.error().message << "\n";
+    return kExitBadInput;
   }
 
   dds::ParticipantOptions participant_options;

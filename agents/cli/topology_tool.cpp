@@ -7,6 +7,8 @@
 #include <mutex>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "agents/cli/command.hpp"
 #include "agents/topology_agent/topology_agent.hpp"
 #include "drover/dds/reader.hpp"
@@ -19,6 +21,11 @@ Error bad_time(const std::string& text, bool allow_forever) {
   return Error{ErrorCode::invalid_argument,
                "'" + text + "' is not a time: give shared-clock nanoseconds (e.g. 1700000000000000000), 'now', " +
                    "'+30s' (units ns, us, ms, s, m, h)" + (allow_forever ? ", or 'forever'" : "")};
+}
+
+Error beyond_clock(const std::string& text, bool allow_forever) {
+  return Error{ErrorCode::invalid_argument, fmt::format("'{}' is outside the shared clock's range [0, {}]{}", text,
+                                                        kLatestTime, allow_forever ? " (use 'forever' for no end)" : "")};
 }
 
 }  // namespace
@@ -41,7 +48,10 @@ Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_foreve
       return unexpected(bad_time(text, allow_forever));
     }
     const double ns = amount * unit->second;
-    if (!std::isfinite(ns) || ns > static_cast<double>(kForever - now)) return unexpected(bad_time(text, allow_forever));
+    if (!std::isfinite(ns)) return unexpected(bad_time(text, allow_forever));
+    if (ns > static_cast<double>(kLatestTime - std::clamp<TimeNs>(now, 0, kLatestTime))) {
+      return unexpected(beyond_clock(text, allow_forever));
+    }
     return now + static_cast<TimeNs>(std::llround(ns));
   }
   TimeNs absolute = 0;
@@ -49,6 +59,7 @@ Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_foreve
   if (text.empty() || parsed.ec != std::errc{} || parsed.ptr != text.data() + text.size()) {
     return unexpected(bad_time(text, allow_forever));
   }
+  if (absolute < 0 || absolute > kLatestTime) return unexpected(beyond_clock(text, allow_forever));
   return absolute;
 }
 

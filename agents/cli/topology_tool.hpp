@@ -20,7 +20,8 @@ namespace drover::cli {
 
 /// A shared-clock time: "NS" (absolute, int64 ns), "now", "+D" (D after `now`) or "forever"
 /// when allow_forever. D is a number with a unit: ns, us, ms, s, m, h (e.g. "+30s", "+1.5m").
-/// \return the time, or invalid_argument naming `text` and the accepted forms.
+/// \return the time, or invalid_argument naming `text` and the accepted forms, or the
+///         clock's range [0, kLatestTime] for a time beyond it.
 Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_forever);
 
 /// The live topology agent that owns `entity`, learnt from its entity description and the

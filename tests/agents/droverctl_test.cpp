@@ -365,6 +365,16 @@ TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
     EXPECT_EQ(status->code, 2) << bad;
     EXPECT_NE(err.find("is not a lock id"), std::string::npos) << bad << ": " << err;
   }
+
+  // Lock times beyond the shared clock's range, checked before anything goes on the network.
+  for (const auto& [from, until] : {std::pair{"-5", "forever"}, std::pair{"0", "9223372036854775806"},
+                                    std::pair{"now", "+3000000h"}}) {
+    status = run_droverctl({"lock", "bar-3", "--from", from, "--until", until, "--reason", "r", "--timeout", "1"}, out,
+                           err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 2) << from << " " << until;
+    EXPECT_NE(err.find("is outside the shared clock's range"), std::string::npos) << from << " " << until << ": " << err;
+  }
 }
 
 }  // namespace

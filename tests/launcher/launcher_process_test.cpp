@@ -175,7 +175,9 @@ TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   const auto dir = scratch_dir("launch_bad");
   write_text(dir / "fleet.json", loop_launch(97, R"(
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "atlantis"})"));
-  auto launcher = start_launch(dir);
+  // A state directory that does not exist yet is not made for a launch that never starts.
+  const auto state = dir / "state";
+  auto launcher = start_launch(dir, {"--state-dir", state.string()});
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(60s);
   ASSERT_TRUE(status.has_value());
@@ -184,6 +186,7 @@ TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   const auto err = read_file((dir / "err.txt").string());
   EXPECT_NE(err.find("fleet.json:agents[1].at: 'atlantis' is not a vertex of"), std::string::npos) << err;
   EXPECT_EQ(err.find("started"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(state));
   std::filesystem::remove_all(dir);
 }
 

@@ -170,16 +170,17 @@ class Fleet {
   std::list<Child> children_;  // a list: ChildProcess cannot be move-assigned
 };
 
-/// A RAN whose vehicle drifts sideways once told to (a slipping wheel, a localisation
-/// error): the simulated vehicle, with an offset added to every pose and footprint it
-/// reports. What the logical agent must catch with its footprint monitoring.
-class DriftingDriver final : public ran::VehicleDriver {
+/// A RAN with faults the test injects: the simulated vehicle, whose reports can be made to
+/// drift sideways (a slipping wheel, a localisation error: what footprint monitoring must
+/// catch) or to leave out commands the driver dropped (a driver bug: what the command watch
+/// must catch).
+class FaultyDriver final : public ran::VehicleDriver {
  public:
-  explicit DriftingDriver(ran::SimVehicle vehicle) : sim_(std::move(vehicle)) {}
+  explicit FaultyDriver(ran::SimVehicle vehicle) : sim_(std::move(vehicle)) {}
 
   void start(ran::StatusSink& sink, TimeNs now) override {
-    drifted_.target = &sink;
-    sim_.start(drifted_, now);
+    faulty_.target = &sink;
+    sim_.start(faulty_, now);
   }
   void stop(TimeNs now) override { sim_.stop(now); }
   void on_move(const ran::MoveCommand& command, TimeNs now) override { sim_.on_move(command, now); }
@@ -188,24 +189,40 @@ class DriftingDriver final : public ran::VehicleDriver {
   void on_pause(TimeNs now) override { sim_.on_pause(now); }
   void on_resume(TimeNs now) override { sim_.on_resume(now); }
   void on_tick(TimeNs now) override { sim_.on_tick(now); }
-  /// From now on, every report is `dx` metres further along x. Call through
-  /// RanRunner::with_driver (never concurrently with the calls above).
-  void drift(double dx) { drifted_.dx = dx; }
+  // Call the faults through RanRunner::with_driver (never concurrently with the calls above).
+  /// From now on, every report is `dx` metres further along x.
+  void drift(double dx) { faulty_.dx = dx; }
+  /// Drops every command not yet ended: the vehicle stops, and no report lists them again,
+  /// as if they had never been given. \return how many were dropped.
+  std::size_t drop_unended(TimeNs now) {
+    std::vector<ran::CommandId> unended;
+    for (const auto& command : faulty_.last.commands) {
+      if (!ran::is_terminal(command.state)) unended.push_back(command.id);
+    }
+    if (unended.empty()) return 0;
+    faulty_.hidden.insert(unended.begin(), unended.end());
+    sim_.on_cancel(unended.front(), now);  // cancels the rest too
+    return unended.size();
+  }
 
  private:
-  struct OffsetSink final : ran::StatusSink {
+  struct FaultySink final : ran::StatusSink {
     ran::StatusSink* target = nullptr;
     double dx = 0;
+    std::set<ran::CommandId> hidden;
+    ran::VehicleStatus last;  ///< as the vehicle reported it
     void deliver(const ran::VehicleStatus& status) override {
-      ran::VehicleStatus moved = status;
-      moved.pose.x += dx;
-      moved.footprint.clear();
-      bg::transform(status.footprint, moved.footprint, bg::strategy::transform::translate_transformer<double, 2, 2>(dx, 0));
-      target->report(std::move(moved));
+      last = status;
+      ran::VehicleStatus faulty = status;
+      std::erase_if(faulty.commands, [&](const ran::CommandProgress& command) { return hidden.contains(command.id); });
+      faulty.pose.x += dx;
+      faulty.footprint.clear();
+      bg::transform(status.footprint, faulty.footprint, bg::strategy::transform::translate_transformer<double, 2, 2>(dx, 0));
+      target->report(std::move(faulty));
     }
   };
   ran::SimDriver sim_;
-  OffsetSink drifted_;
+  FaultySink faulty_;
 };
 
 /// Everything the test observes, in arrival order, with the shared-clock time of arrival.
@@ -528,6 +545,38 @@ class FleetTest : public ::testing::Test {
   /// Waits until the vehicle's logical agent holds its start vertex (it is ready).
   bool wait_ready(const std::string& vehicle, const std::string& vertex) {
     return seen_.wait([&] { return seen_.holders[vertex] == vehicle; }, 60s);
+  }
+
+  /// V1's RAN run in this process, so that the test can inject faults through `driver`.
+  struct InProcessRan {
+    std::unique_ptr<FaultyDriver> driver;
+    std::unique_ptr<ran::RanNode> node;
+  };
+  /// Starts V1's in-process RAN on `domain`, its vehicle standing on `vertex`. \pre watch()
+  /// called. \return nullopt (with a test failure) if it did not start.
+  std::optional<InProcessRan> start_faulty_ran(std::uint32_t domain, const std::string& vertex) {
+    ran::SimVehicleConfig config;
+    config.vehicle_id = "V1";
+    config.max_speed = 1;
+    config.acceleration = 0.5;
+    config.deceleration = 0.5;
+    const auto& start = world_->vertex(*world_->find(vertex)).position;
+    auto vehicle = ran::SimVehicle::create(config, ran::Pose{start.x(), start.y(), 0}, clock_->now(), world_);
+    if (!vehicle) {
+      ADD_FAILURE() << vehicle.error().message;
+      return std::nullopt;
+    }
+    InProcessRan ran{std::make_unique<FaultyDriver>(std::move(*vehicle)), nullptr};
+    ran::RanNodeOptions options;
+    options.vehicle_id = "V1";
+    options.domain_id = domain;
+    auto node = ran::RanNode::create(*ran.driver, options, *clock_);
+    if (!node) {
+      ADD_FAILURE() << node.error().message;
+      return std::nullopt;
+    }
+    ran.node = std::move(*node);
+    return ran;
   }
 
   std::shared_ptr<topology::Topology> world_;
@@ -1190,26 +1239,13 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   Fleet fleet(kDomain, "drift");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  // V1's RAN runs in this process, so that the test can make its vehicle drift.
-  ran::SimVehicleConfig config;
-  config.vehicle_id = "V1";
-  config.max_speed = 1;
-  config.acceleration = 0.5;
-  config.deceleration = 0.5;
-  const auto& start = world_->vertex(*world_->find("left-0")).position;
-  auto vehicle = ran::SimVehicle::create(config, ran::Pose{start.x(), start.y(), 0}, clock_->now(), world_);
-  ASSERT_TRUE(vehicle.has_value()) << vehicle.error().message;
-  DriftingDriver driver(std::move(*vehicle));
-  ran::RanNodeOptions options;
-  options.vehicle_id = "V1";
-  options.domain_id = kDomain;
-  auto node = ran::RanNode::create(driver, options, *clock_);
-  ASSERT_TRUE(node.has_value()) << node.error().message;
+  auto ran = start_faulty_ran(kDomain, "left-0");
+  ASSERT_TRUE(ran.has_value());
   fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
   ASSERT_TRUE(wait_ready("V1", "left-0"));
   ASSERT_EQ(send_order("V1", "v1-drift", {{"right-4", "NOP"}}), "");
   ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
-  (*node)->runner().with_driver([&](TimeNs) { driver.drift(1.5); });
+  ran->node->runner().with_driver([&](TimeNs) { ran->driver->drift(1.5); });
 
   const auto done = wait_order("v1-drift");
   ASSERT_TRUE(done.has_value());
@@ -1220,6 +1256,35 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   std::lock_guard lock(seen_.mutex);
   EXPECT_TRUE(alarm_seen(msg::ALARM_CRITICAL, "V1", "left its allocated area")) << "no critical alarm about the footprint";
   EXPECT_TRUE(seen_.latest["V1"].pose.y < 6.0) << "V1 drove on to the bar after leaving its area";
+  // Stopping the logical agent before the in-process RAN goes away.
+  fleet.stop();
+}
+
+TEST_F(FleetTest, ADriverThatDropsItsMovesFailsTheOrderInsteadOfLeavingItDrivingForEver) {
+  constexpr std::uint32_t kDomain = 24;
+  Fleet fleet(kDomain, "dropped-moves");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  auto ran = start_faulty_ran(kDomain, "left-0");
+  ASSERT_TRUE(ran.has_value());
+  fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  ASSERT_EQ(send_order("V1", "v1-dropped", {{"right-4", "NOP"}}), "");
+  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  // The driver stops the vehicle and forgets its moves, reporting on as if it had none
+  // (before, the order stayed running and the vehicle "driving" for ever).
+  std::size_t dropped = 0;
+  ran->node->runner().with_driver([&](TimeNs now) { dropped = ran->driver->drop_unended(now); });
+  ASSERT_GT(dropped, 0u);
+  const auto done = wait_order("v1-dropped");
+  ASSERT_TRUE(done.has_value()) << "the order whose moves the driver dropped did not end";
+  EXPECT_EQ(done->state(), msg::ORDER_FAILED);
+  EXPECT_NE(done->failure().find("is no longer reported by the RAN, which never reported its end"), std::string::npos)
+      << done->failure();
+  {
+    std::lock_guard lock(seen_.mutex);
+    EXPECT_TRUE(alarm_seen(msg::ALARM_ERROR, "V1", "which never reported its end"));
+  }
   // Stopping the logical agent before the in-process RAN goes away.
   fleet.stop();
 }

@@ -10,6 +10,7 @@
 #include <boost/geometry.hpp>
 #include <gtest/gtest.h>
 
+#include "agents/logical_agent/src/command_watch.hpp"
 #include "agents/logical_agent/src/footprint_monitor.hpp"
 #include "agents/logical_agent/src/late_grants.hpp"
 #include "agents/logical_agent/src/order_book.hpp"
@@ -319,6 +320,53 @@ TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_EQ(custom->kind, ran::ActionKind::custom);
   EXPECT_EQ(custom->name, "lift");
   EXPECT_EQ(custom->parameters.at("height"), "1.2");
+}
+
+// ---- RAN commands ----
+
+/// A status of sequence `sequence` that lists the commands `listed` (running).
+ran::VehicleStatus status_listing(std::uint64_t sequence, std::vector<std::string> listed) {
+  ran::VehicleStatus status;
+  status.sequence = sequence;
+  for (auto& id : listed) status.commands.push_back(ran::CommandProgress{std::move(id), ran::CommandState::running, "", ""});
+  return status;
+}
+
+TEST(CommandWatch, ARanThatDropsACommandWithoutEndingItLosesIt) {
+  using namespace std::chrono_literals;
+  using Loss = CommandWatch::Loss;
+  const auto t0 = CommandWatch::Clock::time_point{} + 100s;
+  CommandWatch watch(t0, 3s);
+  // Statuses that crossed the reply, then the one that lists it: nothing lost.
+  EXPECT_EQ(watch.observe(status_listing(7, {"older"}), "m1", t0 + 1s), Loss::none);
+  EXPECT_EQ(watch.observe(status_listing(8, {"m1"}), "m1", t0 + 2s), Loss::none);
+  EXPECT_EQ(watch.observe(status_listing(8, {"m1"}), "m1", t0 + 9s), Loss::none);  // seen before
+  // A later status of the same RAN without it, its end never seen: dropped.
+  EXPECT_EQ(watch.observe(status_listing(9, {}), "m1", t0 + 10s), Loss::dropped);
+  EXPECT_EQ(loss_text(Loss::dropped).rfind("is no longer reported by the RAN, which never reported its end", 0), 0u);
+}
+
+TEST(CommandWatch, ARanThatRestartedForgotTheCommand) {
+  using namespace std::chrono_literals;
+  const auto t0 = CommandWatch::Clock::time_point{} + 100s;
+  CommandWatch watch(t0, 3s);
+  EXPECT_EQ(watch.observe(status_listing(40, {"m1", "m2"}), "m2", t0), CommandWatch::Loss::none);
+  EXPECT_EQ(watch.observe(status_listing(2, {}), "m2", t0 + 1s), CommandWatch::Loss::restarted);
+  EXPECT_EQ(loss_text(CommandWatch::Loss::restarted), "is no longer reported by the RAN, which restarted");
+}
+
+TEST(CommandWatch, ACommandNeverListedIsLostOnlyOnceTheGraceIsOver) {
+  using namespace std::chrono_literals;
+  const auto t0 = CommandWatch::Clock::time_point{} + 100s;
+  CommandWatch watch(t0, 3s);
+  // Statuses received up to the grace may predate the command (status and reply travel apart).
+  EXPECT_EQ(watch.observe(status_listing(5, {}), "m1", t0 - 1s), CommandWatch::Loss::none);
+  EXPECT_EQ(watch.observe(status_listing(6, {}), "m1", t0 + 3s), CommandWatch::Loss::none);
+  EXPECT_EQ(watch.observe(status_listing(7, {}), "m1", t0 + 3s + 1ms), CommandWatch::Loss::never_listed);
+  // Listed late but within the grace, it is followed from then on.
+  CommandWatch late(t0, 3s);
+  EXPECT_EQ(late.observe(status_listing(6, {"m1"}), "m1", t0 + 2s), CommandWatch::Loss::none);
+  EXPECT_EQ(late.observe(status_listing(7, {"m1"}), "m1", t0 + 60s), CommandWatch::Loss::none);
 }
 
 // ---- route tracking ----

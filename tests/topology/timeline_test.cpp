@@ -575,7 +575,16 @@ TEST_F(TimelineTest, LockRejectsBadRequests) {
   EXPECT_EQ(set.lock(0, {5, 5}, "olga", "").error().code, ErrorCode::invalid_argument);
   EXPECT_EQ(set.lock(0, {5, 6}, "", "").error().code, ErrorCode::invalid_argument);
   EXPECT_EQ(set.lock(9, {5, 6}, "olga", "").error().code, ErrorCode::not_found);
+  // Beyond the shared clock's range (planning adds to lock ends): refused, but for no end.
+  EXPECT_EQ(set.lock(0, {-5, 6}, "olga", "").error().code, ErrorCode::invalid_argument);
+  const auto beyond = set.lock(0, {5, kLatestTime + 1}, "olga", "");
+  ASSERT_FALSE(beyond.has_value());
+  EXPECT_NE(beyond.error().message.find("outside the shared clock's range"), std::string::npos) << beyond.error().message;
+  EXPECT_EQ(set.lock(0, {kLatestTime, kForever - 1}, "olga", "").error().code, ErrorCode::invalid_argument);
   EXPECT_TRUE(set == before);
+  EXPECT_TRUE(set.lock(0, {kLatestTime - 1, kLatestTime}, "olga", "").has_value());
+  EXPECT_TRUE(set.lock(0, {kLatestTime, kForever}, "olga", "").has_value());
+  set = before;
   const auto a = set.lock(0, {5, 6}, "olga", "");
   const auto b = set.lock(0, {5, 6}, "olga", "");
   ASSERT_TRUE(a && b);

@@ -177,6 +177,13 @@ Result<LockReport> TimelineSet::lock(EntityIndex entity, Interval window,
                     std::to_string(window.end) + ") of entity " + std::to_string(entity) +
                     " is empty or reversed");
   }
+  // Planning adds to the ends of what blocks an entity: they stay where that cannot overflow.
+  if (window.start < 0 || (window.end > kLatestTime && window.end != kForever)) {
+    return fail(ErrorCode::invalid_argument,
+                "lock: window [" + std::to_string(window.start) + ", " + std::to_string(window.end) + ") of entity " +
+                    std::to_string(entity) + " is outside the shared clock's range [0, " +
+                    std::to_string(kLatestTime) + "] (its end may also be forever)");
+  }
   if (operator_id.empty()) {
     return fail(ErrorCode::invalid_argument,
                 "lock: entity " + std::to_string(entity) + ": empty operator id");

@@ -41,20 +41,6 @@ bool nobody_answered(const Error& error) {
 
 std::string seconds_text(DurationNs ns) { return fmt::format("{:.1f} s", ns_to_seconds(ns)); }
 
-/// Follows one command through the RAN's statuses, noting in `listed_in` the sequence of
-/// the latest status that lists it. A RAN lists a command until it ends (its end is kept in
-/// ended_commands_ as its status arrives). \return whether the RAN forgot it: `status` does
-/// not list it and its sequence went back below one that did (a RAN that started again
-/// counts from 1).
-bool forgotten_by_ran(const ran::VehicleStatus& status, const ran::CommandId& command,
-                      std::optional<std::uint64_t>& listed_in) {
-  if (status.find_command(command) != nullptr) {
-    listed_in = status.sequence;
-    return false;
-  }
-  return listed_in && status.sequence < *listed_in;
-}
-
 }  // namespace
 
 bool LogicalAgent::wait_event() {
@@ -481,17 +467,25 @@ Status LogicalAgent::drive_to(topology::EntityIndex goal, Activity activity, Dur
   }
 }
 
-std::optional<std::size_t> LogicalAgent::forgotten_move(const ran::VehicleStatus& status,
-                                                        ListedIn& listed_in) const {
-  for (const auto& [id, target] : pending_moves_) {
-    if (forgotten_by_ran(status, id, listed_in[id]) && !ended_commands_.contains(id)) return target;
+CommandWatch LogicalAgent::watch_from_now() {
+  // A status lists a command it accepted at once; one still missing after the time a RAN
+  // may be silent was not a late status.
+  return CommandWatch(std::chrono::steady_clock::now(), kRanSilence);
+}
+
+std::optional<std::string> LogicalAgent::lost_move() {
+  for (auto& move : pending_moves_) {
+    if (ended_commands_.contains(move.id)) continue;
+    if (const auto loss = move.watch.observe(*status_, move.id, status_received_); loss != CommandWatch::Loss::none) {
+      return fmt::format("the move to '{}' {}: the vehicle stands where the RAN left it",
+                         topology_->id(route_->step(move.target).entity), loss_text(loss));
+    }
   }
   return std::nullopt;
 }
 
 LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
   bool replan = false;
-  ListedIn listed_in;  // see forgotten_move
   for (;;) {
     if (stopping_) {
       failure = "the logical agent is shutting down";
@@ -502,7 +496,7 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
     {
       std::unique_lock lock(mutex_);
       while (!pending_moves_.empty()) {
-        const auto [id, target] = pending_moves_.front();
+        const auto& [id, target, watch] = pending_moves_.front();
         const auto ended = ended_commands_.find(id);
         if (ended == ended_commands_.end()) break;
         if (ended->second.state != ran::CommandState::finished) {
@@ -525,10 +519,8 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
       }
       // Checked with the ends above under one lock: a status that ends a move records its
       // end before it is the latest.
-      if (const auto lost = status_ ? forgotten_move(*status_, listed_in) : std::nullopt) {
-        failure = fmt::format("the move to '{}' is no longer reported by the RAN, which restarted: the vehicle "
-                              "stands where the RAN left it",
-                              topology_->id(route_->step(*lost).entity));
+      if (auto lost = status_ ? lost_move() : std::nullopt) {
+        failure = std::move(*lost);
         lock.unlock();
         raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
         stop_vehicle();
@@ -601,11 +593,11 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
                             : "the RAN did not take the move to '" + move.target_vertex + "': " + verdict.error().message;
           raise_alarm(msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
           // Unanswered, the RAN may still have taken the move: cancel it with the others.
-          if (!verdict) pending_moves_.emplace_back(move.id, *edge + 1);
+          if (!verdict) pending_moves_.push_back(PendingMove{move.id, *edge + 1, watch_from_now()});
           stop_vehicle();
           return FollowResult::failed;
         }
-        pending_moves_.emplace_back(move.id, *edge + 1);
+        pending_moves_.push_back(PendingMove{move.id, *edge + 1, watch_from_now()});
       }
     }
     set_activity(error_since_ || pending_moves_.empty() ? Activity::waiting : drive_activity_);
@@ -797,8 +789,8 @@ bool LogicalAgent::stop_vehicle() {
   std::vector<ran::CommandId> unended;
   {
     std::lock_guard lock(mutex_);
-    for (const auto& [id, target] : pending_moves_) {
-      if (!ended_commands_.contains(id)) unended.push_back(id);
+    for (const auto& move : pending_moves_) {
+      if (!ended_commands_.contains(move.id)) unended.push_back(move.id);
     }
   }
   if (!unended.empty()) {
@@ -888,17 +880,18 @@ Status LogicalAgent::operate(const ran::ActionCommand& requested, Activity activ
   if (verdict->rejected()) {
     return fail(ErrorCode::not_permitted, "the RAN rejected action '" + action.name + "': " + verdict->code + " " + verdict->reason);
   }
-  return await_action(action.id, action.name, std::nullopt);
+  return await_action(action.id, action.name, watch_from_now());
 }
 
 Status LogicalAgent::await_action(const ran::CommandId& command, const std::string& name,
-                                  std::optional<std::uint64_t> listed_in) {
+                                  CommandWatch watch) {
   for (;;) {
     if (!wait_event()) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     bool replan = false;
     process_notices(replan);
     std::optional<ran::CommandProgress> ended;
     std::optional<ran::VehicleStatus> status;
+    CommandWatch::Clock::time_point received;
     {
       // Both at once: a status that ends the command records its end before it is the latest.
       std::lock_guard lock(mutex_);
@@ -907,6 +900,7 @@ Status LogicalAgent::await_action(const ran::CommandId& command, const std::stri
         ended_commands_.erase(found);
       }
       status = status_;
+      received = status_received_;
     }
     if (ended) {
       if (ended->state == ran::CommandState::finished) return {};
@@ -914,10 +908,9 @@ Status LogicalAgent::await_action(const ran::CommandId& command, const std::stri
                                               ended->code + " " + ended->reason);
     }
     if (status) {
-      if (forgotten_by_ran(*status, command, listed_in)) {
-        return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command +
-                                                "') is no longer reported by the RAN, which restarted: whether it "
-                                                "was done is unknown (check the vehicle)");
+      if (const auto loss = watch.observe(*status, command, received); loss != CommandWatch::Loss::none) {
+        return fail(ErrorCode::unavailable, "action '" + name + "' (RAN command '" + command + "') " +
+                                                loss_text(loss) + ": whether it was done is unknown (check the vehicle)");
       }
       if (auto error = check_errors(*status)) {
         if (auto cancelled = ran_->cancel(command, options_.call_timeout); !cancelled) {

@@ -26,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "agents/logical_agent/src/command_watch.hpp"
 #include "agents/logical_agent/src/footprint_monitor.hpp"
 #include "agents/logical_agent/src/late_grants.hpp"
 #include "agents/logical_agent/src/order_book.hpp"
@@ -216,23 +217,19 @@ class LogicalAgent {
   Status drive_to(topology::EntityIndex goal, Activity activity, DurationNs patience,
                   std::optional<RouteTracker> planned = std::nullopt);
   FollowResult follow(std::string& failure);
-  /// Per command, the sequence of the latest RAN status that listed it.
-  using ListedIn = std::map<ran::CommandId, std::optional<std::uint64_t>>;
-  /// The target step of a pending move that the RAN forgot: listed in one of its statuses,
-  /// then missing, without an end, from `status` whose sequence went back below that one
-  /// (a RAN that started again counts from 1). Notes in `listed_in` the sequence of the
-  /// latest status that listed each pending move. \pre mutex_ held
-  std::optional<std::size_t> forgotten_move(const ran::VehicleStatus& status, ListedIn& listed_in) const;
+  /// A watch over a command the RAN accepted just now.
+  static CommandWatch watch_from_now();
+  /// A pending move the RAN lost (CommandWatch) in the latest status, without an end:
+  /// why follow fails the order. \pre mutex_ held, status_ set
+  std::optional<std::string> lost_move();
   /// Performs an action where the vehicle stands; `for_order`: the running order's operation
   /// (its command is recorded first, OrderBook::action_commanded). \return success or why
   /// it failed.
   Status operate(const ran::ActionCommand& action, Activity activity, bool for_order = false);
-  /// Waits for the end of action `command` (named `name` in messages) on the RAN;
-  /// `listed_in`: the sequence of a status that listed it already. \return success when it
-  /// finished, otherwise why not (it failed or was cancelled, a RAN error, or the RAN
-  /// restarted, its sequence going back, and no longer lists it: it forgot it).
-  Status await_action(const ran::CommandId& command, const std::string& name,
-                      std::optional<std::uint64_t> listed_in);
+  /// Waits for the end of action `command` (named `name` in messages) on the RAN, followed
+  /// by `watch`. \return success when it finished, otherwise why not (it failed or was
+  /// cancelled, a RAN error, or the RAN lost it: CommandWatch).
+  Status await_action(const ran::CommandId& command, const std::string& name, CommandWatch watch);
   /// The running order was restored with its operation at `destination` commanded as
   /// `command` by an earlier life: waits for that command's outcome. \return success when
   /// it finished; why not when it failed, or when the RAN does not report it (it restarted
@@ -359,7 +356,12 @@ class LogicalAgent {
   /// its windows longer, so the windows here are at most as long as the timelines' (a
   /// delay asked for from them moves it a little further than needed, never too little).
   std::optional<RouteTracker> remnant_;
-  std::deque<std::pair<ran::CommandId, std::size_t>> pending_moves_;  ///< id, target step
+  struct PendingMove {
+    ran::CommandId id;
+    std::size_t target;  ///< the route step the move ends on
+    CommandWatch watch;
+  };
+  std::deque<PendingMove> pending_moves_;  ///< moves the RAN accepted, oldest first, until they end
   std::optional<topology::EntityIndex> vertex_;  ///< where the vehicle stands or last stood
   Activity activity_ = Activity::idle;
   TimeNs idle_since_ = 0;

@@ -64,19 +64,21 @@ Status LogicalAgent::resume_action(const ran::CommandId& command, const Destinat
       fmt::format("action '{}' at '{}' (RAN command '{}')", destination.operation, destination.location_id, command);
   const auto action = operation_action(destination);
   set_activity(action && action->kind == ran::ActionKind::charge ? Activity::charging : Activity::operating);
-  std::optional<std::uint64_t> listed_in;
-  if (const auto status = latest_status(); status && status->find_command(command) != nullptr) {
-    listed_in = status->sequence;
-  }
+  // Listed now, the command is followed from this status on; if not, the RAN never got it
+  // or restarted too.
+  CommandWatch watch = watch_from_now();
+  const auto status = latest_status();
+  const bool listed = status && status->find_command(command) != nullptr;
+  if (listed) watch.observe(*status, command, std::chrono::steady_clock::now());
   Status outcome;
-  if (!listed_in) {
+  if (!listed) {
     outcome = fail(ErrorCode::unavailable,
                    "the logical agent restarted while " + what +
                        " was under way, and the RAN does not report that command: whether it was done is unknown "
                        "(check the vehicle, then send the rest of the order again)");
   } else {
     spdlog::info("restored order: waiting for the outcome of {}, commanded by an earlier life", what);
-    outcome = await_action(command, destination.operation, listed_in);
+    outcome = await_action(command, destination.operation, watch);
   }
   std::lock_guard lock(mutex_);
   adopted_command_.reset();

@@ -410,7 +410,8 @@ class TimelineSet {
   Result<DelayReport> delay(const AgentId& agent, RouteId route, EntityIndex entity,
                             DurationNs by);
 
-  /// Locks `entity` during `window`. invalid_argument for a bad window or empty operator,
+  /// Locks `entity` during `window`. invalid_argument for a bad window (empty, reversed, or
+  /// beyond [0, kLatestTime] but for an end of kForever) or empty operator,
   /// not_found for an entity not owned. Reservations already there stay (see LockReport).
   Result<LockReport> lock(EntityIndex entity, Interval window, std::string operator_id,
                           std::string reason);
