@@ -2,8 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "drover/common/json_syntax.hpp"
+#include "drover/common/json_document.hpp"
 #include "drover/common/text_file.hpp"
+#include "drover/topology/topology_builder.hpp"
 
 namespace drover::carp {
 
@@ -36,15 +37,17 @@ Result<VehicleProfile> vehicle_profile_from_json(const nlohmann::json& json) {
 }
 
 Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& error) {
-    const auto syntax = json_syntax_error(text, error);
-    const std::string at = syntax.where.empty() ? where : where + ":" + syntax.where;
-    return fail(ErrorCode::parse, at + ": " + syntax.what);
+  const auto json = parse_json_document<nlohmann::json>(text);
+  if (!json) {
+    // One message (an Error has one): every problem as tools print one, on one line.
+    std::string message;
+    for (const auto& problem : json.error()) {
+      if (!message.empty()) message += "; ";
+      message += topology::diagnostic_text(where, topology::Diagnostic{problem.where, problem.what});
+    }
+    return fail(ErrorCode::parse, message);
   }
-  auto vehicle = vehicle_profile_from_json(json);
+  auto vehicle = vehicle_profile_from_json(*json);
   if (!vehicle) return fail(vehicle.error().code, where + ": " + vehicle.error().message);
   return vehicle;
 }

@@ -97,6 +97,39 @@ TEST(LaunchFile, NotJsonOrNotAnObject) {
   EXPECT_NE(problems_of("[1, 2]").find("must be a JSON object"), std::string::npos);
 }
 
+/// A good loop launch file in which, when `twice`, three keys are given a second time:
+/// in the header, in a profile and in an agent entry.
+std::string file_with_keys_given_twice(bool twice) {
+  const std::string header = twice ? R"("time_factor": 10, )" : "";
+  const std::string profile = twice ? R"(, "max_speed": 5)" : "";
+  const std::string entry = twice ? R"(, "at": "south")" : "";
+  return R"({"domain": 226, "time_factor": 1, "epoch": 1000, "topology": "topologies/loop.json", )" + header +
+         R"("vehicle_profiles": {"slow": {"max_speed": 0.5, "length": 0.8)" + profile + R"(}},
+            "agents": [{"kind": "topology"}, {"kind": "routing"},
+                       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "profile": "slow")" +
+         entry + "}]}";
+}
+
+// JSON allows a key twice in one object and the parser keeps the last value: a pasted or
+// edited line must not silently win over the one above it.
+TEST(LaunchFile, KeysGivenTwiceAreRefusedByTheirPath) {
+  auto once = parse(file_with_keys_given_twice(false));
+  ASSERT_TRUE(once.has_value()) << once.error().front().where << ": " << once.error().front().what;
+  const auto text = problems_of(file_with_keys_given_twice(true));
+  EXPECT_EQ(text,
+            "time_factor: key given twice in the same object\n"
+            "vehicle_profiles.slow.max_speed: key given twice in the same object\n"
+            "agents[2].at: key given twice in the same object\n");
+}
+
+// The parser takes a NUL byte for the end of the text: what follows one must not vanish.
+TEST(LaunchFile, NulByteIsRefusedWithLineAndColumn) {
+  const std::string good = loop_file(R"({"kind": "topology"}, {"kind": "routing"})");
+  ASSERT_TRUE(parse(good).has_value());
+  EXPECT_EQ(problems_of(good + "\n" + '\0' + R"({"agents": []})"),
+            "line 3, column 1: malformed JSON: NUL byte (a JSON text cannot contain one)\n");
+}
+
 TEST(LaunchFile, MissingOrBadHeaderFields) {
   const auto missing = problems_of(R"({"agents": [{"kind": "routing"}]})");
   EXPECT_NE(missing.find("topology: missing"), std::string::npos) << missing;

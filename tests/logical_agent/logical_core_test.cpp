@@ -549,5 +549,23 @@ TEST(VehicleProfileJson, ParsesAndNamesBadFields) {
             "/dev/zero: is a device or socket, not a file");
 }
 
+// JSON allows a key twice and the parser keeps the last value; a NUL byte ends its text. A
+// profile must not silently lose a value either way.
+TEST(VehicleProfileJson, KeysGivenTwiceAndNulBytesAreRefused) {
+  auto twice = carp::parse_vehicle_profile(R"({"max_speed": 1, "width": 0.5, "max_speed": 10})", "v.json");
+  ASSERT_FALSE(twice);
+  EXPECT_EQ(twice.error().code, ErrorCode::parse);
+  EXPECT_EQ(twice.error().message, "v.json:max_speed: key given twice in the same object");
+  auto two = carp::parse_vehicle_profile(R"({"id": "a", "width": 1, "id": "b", "width": 2})", "v.json");
+  ASSERT_FALSE(two);
+  EXPECT_EQ(two.error().message,
+            "v.json:id: key given twice in the same object; v.json:width: key given twice in the same object");
+  auto nul = carp::parse_vehicle_profile(std::string(R"({"max_speed": 1})") + "\n  " + '\0' + R"({"max_speed": 9})",
+                                         "v.json");
+  ASSERT_FALSE(nul);
+  EXPECT_EQ(nul.error().code, ErrorCode::parse);
+  EXPECT_EQ(nul.error().message, "v.json:line 2, column 3: malformed JSON: NUL byte (a JSON text cannot contain one)");
+}
+
 }  // namespace
 }  // namespace drover::logical_agent

@@ -291,6 +291,23 @@ TEST(JsonFormat, ManyKeysGivenTwiceAreNamedUpToAHundredThenCounted) {
   EXPECT_EQ(errors[100].what, std::to_string(kDepth - 100) + " more keys given twice");
 }
 
+// nlohmann's lexer takes a NUL byte for the end of the text: a file with one after a whole
+// document loaded as if the rest were absent, and one cut short by NULs was reported as
+// "unexpected end of input".
+TEST(JsonFormat, NulByteIsRefusedWithLineAndColumn) {
+  const std::string document = R"({"name": "z", "vertices": [], "edges": []})";
+  ASSERT_TRUE(parse_topology_json(document).has_value()) << "the document alone is good";
+  const auto trailing = errors_of(parse_topology_json(document + "\n" + '\0' + "garbage"));
+  ASSERT_EQ(trailing.size(), 1u) << dump(trailing);
+  EXPECT_EQ(trailing[0].where, "line 2, column 1");
+  EXPECT_EQ(trailing[0].what, "malformed JSON: NUL byte (a JSON text cannot contain one)");
+  const auto cut = errors_of(parse_topology_json("{\"name\": \"z\",\n  \"vertices\": [" +
+                                                 std::string(4, '\0')));
+  ASSERT_EQ(cut.size(), 1u) << dump(cut);
+  EXPECT_EQ(cut[0].where, "line 2, column 16");
+  EXPECT_EQ(cut[0].what, "malformed JSON: NUL byte (a JSON text cannot contain one)");
+}
+
 TEST(JsonFormat, FootprintPointsMustBePairsOfNumbers) {
   const auto errors = errors_of(parse_topology_json(R"({"name": "f", "vertices": [
       {"id": "a", "x": 0, "y": 0, "footprint": [[0, 0], [1], [1, "1"], 7]},

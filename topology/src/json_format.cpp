@@ -1,15 +1,13 @@
 #include "drover/topology/json_format.hpp"
 
 #include <cstdint>
-#include <functional>
 #include <initializer_list>
 #include <optional>
-#include <set>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
-#include "drover/common/json_syntax.hpp"
+#include "drover/common/json_document.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/topology/footprints.hpp"
 
@@ -19,27 +17,6 @@ namespace {
 
 // Ordered, so that diagnostics follow the file and written files keep a readable order.
 using Json = nlohmann::ordered_json;
-
-void append_member(std::string& where, std::string_view key) {
-  if (!where.empty()) where += '.';
-  where += key;
-}
-
-void append_element(std::string& where, std::size_t index) {
-  where += '[';
-  where += std::to_string(index);
-  where += ']';
-}
-
-std::string member(std::string where, std::string_view key) {
-  append_member(where, key);
-  return where;
-}
-
-std::string element(std::string where, std::size_t index) {
-  append_element(where, index);
-  return where;
-}
 
 /// Turns a parsed document into builder specs, collecting every structural problem (wrong
 /// type, missing or unknown field) with its JSON path.
@@ -59,14 +36,14 @@ class SpecReader {
     TopologyBuilder builder(name.value_or(""), options);
     if (const Json* vertices = array_field(document, "vertices", "")) {
       for (std::size_t i = 0; i < vertices->size(); ++i) {
-        if (auto spec = read_vertex((*vertices)[i], element("vertices", i))) {
+        if (auto spec = read_vertex((*vertices)[i], json_element_path("vertices", i))) {
           builder.add_vertex(std::move(*spec));
         }
       }
     }
     if (const Json* edges = array_field(document, "edges", "")) {
       for (std::size_t i = 0; i < edges->size(); ++i) {
-        if (auto spec = read_edge((*edges)[i], element("edges", i))) {
+        if (auto spec = read_edge((*edges)[i], json_element_path("edges", i))) {
           builder.add_edge(std::move(*spec));
         }
       }
@@ -101,7 +78,7 @@ class SpecReader {
         expected += expected.empty() ? "" : ", ";
         expected += name;
       }
-      report(member(where, key), "unknown field (expected one of: " + expected + ")");
+      report(json_member_path(where, key), "unknown field (expected one of: " + expected + ")");
     }
   }
 
@@ -109,7 +86,7 @@ class SpecReader {
                     bool required) {
     const auto found = object.find(std::string(key));
     if (found == object.end()) {
-      if (required) report(member(where, key), "required field is missing");
+      if (required) report(json_member_path(where, key), "required field is missing");
       return nullptr;
     }
     return &*found;
@@ -119,7 +96,7 @@ class SpecReader {
     const Json* value = field(object, key, where, true);
     if (value == nullptr) return nullptr;
     if (!value->is_array()) {
-      wrong_type(*value, member(where, key), "an array");
+      wrong_type(*value, json_member_path(where, key), "an array");
       return nullptr;
     }
     return value;
@@ -130,7 +107,7 @@ class SpecReader {
     const Json* value = field(object, key, where, required);
     if (value == nullptr) return std::nullopt;
     if (!value->is_string()) {
-      wrong_type(*value, member(where, key), "a string");
+      wrong_type(*value, json_member_path(where, key), "a string");
       return std::nullopt;
     }
     return value->get<std::string>();
@@ -141,7 +118,7 @@ class SpecReader {
     const Json* value = field(object, key, where, required);
     if (value == nullptr) return std::nullopt;
     if (!value->is_number()) {
-      wrong_type(*value, member(where, key), "a number");
+      wrong_type(*value, json_member_path(where, key), "a number");
       return std::nullopt;
     }
     return value->get<double>();
@@ -152,7 +129,7 @@ class SpecReader {
     const Json* value = field(object, key, where, false);
     if (value == nullptr) return std::nullopt;
     if (!value->is_boolean()) {
-      wrong_type(*value, member(where, key), "a boolean");
+      wrong_type(*value, json_member_path(where, key), "a boolean");
       return std::nullopt;
     }
     return value->get<bool>();
@@ -167,7 +144,7 @@ class SpecReader {
       if (*shape == "square" || *shape == "disc") {
         options.vertex_disc = *shape == "disc";
       } else {
-        report(member(where, "vertex_shape"),
+        report(json_member_path(where, "vertex_shape"),
                "unknown shape '" + *shape + "' (expected square or disc)");
       }
     }
@@ -185,7 +162,7 @@ class SpecReader {
                               : count < 0            ? -1
                                                      : static_cast<int>(count);
       } else {
-        wrong_type(*points, member(where, "disc_points"), "an integer");
+        wrong_type(*points, json_member_path(where, "disc_points"), "an integer");
       }
     }
   }
@@ -193,7 +170,7 @@ class SpecReader {
   std::optional<Polygon> read_footprint(const Json& object, const std::string& where) {
     const Json* value = field(object, "footprint", where, false);
     if (value == nullptr) return std::nullopt;
-    const std::string path = member(where, "footprint");
+    const std::string path = json_member_path(where, "footprint");
     if (!value->is_array()) {
       wrong_type(*value, path, "an array of [x, y] points");
       return std::nullopt;
@@ -210,7 +187,7 @@ class SpecReader {
         } else if (point.is_array()) {
           got = std::string("[") + point[0].type_name() + ", " + point[1].type_name() + "]";
         }
-        report(element(path, i), "expected a point [x, y] of two numbers, got " + got);
+        report(json_element_path(path, i), "expected a point [x, y] of two numbers, got " + got);
         complete = false;
         continue;
       }
@@ -225,7 +202,7 @@ class SpecReader {
     std::vector<std::string> list;
     const Json* value = field(object, key, where, false);
     if (value == nullptr) return list;
-    const std::string path = member(where, key);
+    const std::string path = json_member_path(where, key);
     if (!value->is_array()) {
       wrong_type(*value, path, "an array of strings");
       return list;
@@ -234,7 +211,7 @@ class SpecReader {
       if ((*value)[i].is_string()) {
         list.push_back((*value)[i].get<std::string>());
       } else {
-        wrong_type((*value)[i], element(path, i), "a string");
+        wrong_type((*value)[i], json_element_path(path, i), "a string");
       }
     }
     return list;
@@ -244,7 +221,7 @@ class SpecReader {
     Restrictions restrictions;
     const Json* value = field(object, "restrictions", owner, false);
     if (value == nullptr) return restrictions;
-    const std::string where = member(owner, "restrictions");
+    const std::string where = json_member_path(owner, "restrictions");
     if (!expect_object(*value, where)) return restrictions;
     only_fields(*value, where,
                 {"max_speed", "max_payload", "allowed_vehicle_types", "forbidden_vehicle_types",
@@ -262,13 +239,13 @@ class SpecReader {
     Properties properties;
     const Json* value = field(object, "properties", owner, false);
     if (value == nullptr) return properties;
-    const std::string where = member(owner, "properties");
+    const std::string where = json_member_path(owner, "properties");
     if (!expect_object(*value, where)) return properties;
     for (const auto& [key, text] : value->items()) {
       if (text.is_string()) {
         properties.emplace(key, text.get<std::string>());
       } else {
-        wrong_type(text, member(where, key), "a string");
+        wrong_type(text, json_member_path(where, key), "a string");
       }
     }
     return properties;
@@ -288,8 +265,9 @@ class SpecReader {
       if (const auto known = vertex_kind_from_string(*kind)) {
         spec.kind = *known;
       } else {
-        report(member(where, "kind"), "unknown vertex kind '" + *kind +
-                                          "' (expected waypoint, station, parking or charger)");
+        report(json_member_path(where, "kind"),
+               "unknown vertex kind '" + *kind +
+                   "' (expected waypoint, station, parking or charger)");
       }
     }
     spec.footprint = read_footprint(object, where);
@@ -323,81 +301,6 @@ class SpecReader {
   }
 
   Diagnostics diagnostics_;
-};
-
-/// Watches the parser for keys given twice in one object (JSON allows it and nlohmann keeps
-/// the last, which would let a pasted or misspelt duplicate pass silently). Tracks the JSON
-/// path of the value being parsed so that the duplicate can be named.
-class DuplicateKeyWatch {
- public:
-  Diagnostics& duplicates() { return duplicates_; }
-
-  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, Json& parsed) {
-    using Event = nlohmann::json::parse_event_t;
-    switch (event) {
-      case Event::object_start:
-      case Event::array_start:
-        count_element();
-        frames_.push_back(Frame{event == Event::object_start, {}, 0, {}});
-        break;
-      case Event::object_end:
-      case Event::array_end:
-        if (!frames_.empty()) frames_.pop_back();
-        break;
-      case Event::key: {
-        Frame& object = frames_.back();
-        object.key = parsed.get<std::string>();
-        if (!object.keys.insert(object.key).second) report_duplicate();
-        break;
-      }
-      case Event::value:
-        count_element();
-        break;
-    }
-    return true;
-  }
-
- private:
-  struct Frame {
-    bool object = false;
-    std::string key;              // objects: the key being parsed
-    std::size_t elements = 0;     // arrays: elements started so far
-    std::set<std::string> keys;   // objects: keys seen
-  };
-
-  void count_element() {
-    if (!frames_.empty() && !frames_.back().object) ++frames_.back().elements;
-  }
-
-  /// Reports the key just read, by its path, up to kMaxNamed of them (each path is as long
-  /// as the nesting is deep: naming a duplicate at every level of a deeply nested file
-  /// took minutes), then counts the rest in one last diagnostic.
-  void report_duplicate() {
-    constexpr std::size_t kMaxNamed = 100;
-    if (duplicates_.size() < kMaxNamed) {
-      duplicates_.push_back(Diagnostic{path(), "key given twice in the same object"});
-      return;
-    }
-    ++unnamed_;
-    if (duplicates_.size() == kMaxNamed) duplicates_.push_back(Diagnostic{});
-    duplicates_.back().what = std::to_string(unnamed_) + " more keys given twice";
-  }
-
-  std::string path() const {
-    std::string where;
-    for (const Frame& frame : frames_) {
-      if (frame.object) {
-        append_member(where, frame.key);
-      } else {
-        append_element(where, frame.elements == 0 ? 0 : frame.elements - 1);
-      }
-    }
-    return where;
-  }
-
-  std::vector<Frame> frames_;
-  Diagnostics duplicates_;
-  std::size_t unnamed_ = 0;  // duplicates found after kMaxNamed were named
 };
 
 Json point_json(const Point& point) { return Json::array({point.x(), point.y()}); }
@@ -486,17 +389,16 @@ void write_list(std::string& out, std::string_view key, const Items& items, ToJs
 }  // namespace
 
 Result<Topology, Diagnostics> parse_topology_json(std::string_view text) {
-  Json document;
-  DuplicateKeyWatch watch;
-  try {
-    document = Json::parse(text.begin(), text.end(), std::ref(watch));
-  } catch (const nlohmann::json::exception& error) {
-    auto syntax = json_syntax_error(text, error);
-    return unexpected(Diagnostics{Diagnostic{std::move(syntax.where), std::move(syntax.what)}});
+  auto document = parse_json_document<Json>(text);
+  if (!document) {
+    Diagnostics problems;
+    for (auto& problem : document.error()) {
+      problems.push_back(Diagnostic{std::move(problem.where), std::move(problem.what)});
+    }
+    return unexpected(std::move(problems));
   }
-  if (!watch.duplicates().empty()) return unexpected(std::move(watch.duplicates()));
   SpecReader reader;
-  auto builder = reader.read_document(document);
+  auto builder = reader.read_document(*document);
   // Structural problems first: the builder's checks on half-read specs would only add noise.
   if (!reader.diagnostics().empty()) return unexpected(std::move(reader.diagnostics()));
   return std::move(*builder).build();

@@ -14,7 +14,7 @@
 #include "agents/cli/number_checks.hpp"
 #include "drover/carp/vehicle_profile_json.hpp"
 #include "drover/common/clock.hpp"
-#include "drover/common/json_syntax.hpp"
+#include "drover/common/json_document.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/launcher/load_generator.hpp"
@@ -178,14 +178,12 @@ class LaunchFileParser {
   }
 
   Result<LaunchFile, LaunchProblems> parse(std::string_view text) {
-    Json root;
-    try {
-      root = Json::parse(text);
-    } catch (const Json::exception& error) {
-      auto syntax = json_syntax_error(text, error);
-      checker_.problem(std::move(syntax.where), std::move(syntax.what));
+    auto document = parse_json_document<Json>(text);
+    if (!document) {
+      for (auto& problem : document.error()) checker_.problem(std::move(problem.where), std::move(problem.what));
       return unexpected(checker_.take());
     }
+    const Json& root = *document;
     if (!root.is_object()) {
       checker_.problem("", "the launch file must be a JSON object");
       return unexpected(checker_.take());

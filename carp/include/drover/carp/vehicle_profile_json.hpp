@@ -19,9 +19,11 @@ namespace drover::carp {
 Result<VehicleProfile> vehicle_profile_from_json(const nlohmann::json& json);
 
 /// Parses a profile from JSON text; `where` names the source in messages (a file name).
-/// \return the validated profile, or parse (not JSON, not an object, a field of the wrong
-///         type, an unknown field) or invalid_argument (a value out of range), each naming
-///         `where` and the field.
+/// \return the validated profile, or parse (not JSON, a NUL byte, a key given twice, not an
+///         object, a field of the wrong type, an unknown field) or invalid_argument (a value
+///         out of range), each naming `where` and the field or the line and column
+///         ("v.json:max_speed: key given twice in the same object"; several such problems
+///         joined by "; ").
 Result<VehicleProfile> parse_vehicle_profile(const std::string& text, const std::string& where);
 
 /// Reads and parses the file at `path`. \return as parse_vehicle_profile, or io when the

@@ -15,9 +15,9 @@ namespace drover::topology {
 
 /// Loads a topology from a JSON file.
 /// \return the topology, or every problem found: an unreadable or empty file (where ""),
-///         malformed JSON (where "line L, column C"), wrong types, missing or unknown
-///         fields (where the JSON path, e.g. "vertices[2].x"), and everything
-///         TopologyBuilder::build() rejects.
+///         malformed JSON or a NUL byte (where "line L, column C"), keys given twice, wrong
+///         types, missing or unknown fields (where the JSON path, e.g. "vertices[2].x"), and
+///         everything TopologyBuilder::build() rejects.
 Result<Topology, Diagnostics> load_topology_json(const std::filesystem::path& path);
 
 /// Same as load_topology_json, from the text of a document.

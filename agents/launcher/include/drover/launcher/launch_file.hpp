@@ -71,7 +71,9 @@ using LaunchProblems = topology::Diagnostics;
 
 /// Reads and checks a launch file. Relative paths in it are relative to its directory;
 /// relative journal paths (`db`) are relative to `state_dir`.
-/// \return the launch file, or every problem found (nothing may be started then).
+/// \return the launch file, or every problem found (nothing may be started then); a
+///         file that is not one strict JSON document (malformed, a NUL byte, keys given
+///         twice: parse_json_document) is refused with those problems alone.
 Result<LaunchFile, LaunchProblems> load_launch_file(const std::filesystem::path& path,
                                                     const std::filesystem::path& state_dir);
 
