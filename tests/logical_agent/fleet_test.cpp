@@ -1260,7 +1260,7 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   fleet.stop();
 }
 
-TEST_F(FleetTest, ADriverThatDropsItsMovesFailsTheOrderInsteadOfLeavingItDrivingForEver) {
+TEST_F(FleetTest, ADriverThatDropsItsMovesFailsTheOrderAndTheVehicleWorksOnFromWhereItStopped) {
   constexpr std::uint32_t kDomain = 24;
   Fleet fleet(kDomain, "dropped-moves");
   fleet.start_infrastructure();
@@ -1284,6 +1284,18 @@ TEST_F(FleetTest, ADriverThatDropsItsMovesFailsTheOrderInsteadOfLeavingItDriving
   {
     std::lock_guard lock(seen_.mutex);
     EXPECT_TRUE(alarm_seen(msg::ALARM_ERROR, "V1", "which never reported its end"));
+  }
+  // Stopped part-way along the edge, the vehicle drives on to the vertex it was heading for
+  // and works on from there (before, it stood there for ever: "stands on no vertex").
+  EXPECT_TRUE(seen_.wait([&] { return seen_.holders["left-1"] == "V1"; }, 60s)) << "V1 did not drive on to left-1";
+  ASSERT_EQ(send_order("V1", "v1-on", {{"left-4", "NOP"}}), "");
+  const auto on = wait_order("v1-on");
+  ASSERT_TRUE(on.has_value()) << "the next order did not end";
+  EXPECT_EQ(on->state(), msg::ORDER_FINISHED) << on->failure();
+  {
+    std::lock_guard lock(seen_.mutex);
+    EXPECT_FALSE(alarm_seen(msg::ALARM_ERROR, "V1", "stands on no vertex"));
+    EXPECT_TRUE(seen_.hold_violations.empty()) << seen_.hold_violations.front();
   }
   // Stopping the logical agent before the in-process RAN goes away.
   fleet.stop();

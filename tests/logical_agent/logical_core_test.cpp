@@ -419,6 +419,23 @@ TEST(RouteTracker, AllocatesWithinTheLookAheadAndMovesOnlyOntoAllocatedSteps) {
   EXPECT_TRUE(route.arrived());
 }
 
+TEST(RouteTracker, AMoveAlongAnEdgeGoesToEitherEndWithinTheEdgeAndBothEnds) {
+  const auto world = h_crossing();
+  const auto edge = index(*world, "left-0<->left-1");
+  // Back along the bidirectional edge, as a vehicle stopped part-way on it may drive.
+  const auto back = move_along(*world, edge, index(*world, "left-0"), "m7", 0.5);
+  EXPECT_EQ(back.id, "m7");
+  EXPECT_EQ(back.target_vertex, "left-0");
+  EXPECT_EQ(back.edge, "left-0<->left-1");
+  EXPECT_DOUBLE_EQ(back.max_speed, 0.5) << "the vehicle's limit, below the edge's";
+  EXPECT_DOUBLE_EQ(back.target.x, world->vertex(index(*world, "left-0")).position.x());
+  EXPECT_DOUBLE_EQ(back.target.y, world->vertex(index(*world, "left-0")).position.y());
+  ASSERT_EQ(back.area.size(), 3u);
+  EXPECT_TRUE(boost::geometry::equals(back.area[0], world->footprint(index(*world, "left-1"))));
+  EXPECT_TRUE(boost::geometry::equals(back.area[1], world->footprint(edge)));
+  EXPECT_TRUE(boost::geometry::equals(back.area[2], world->footprint(index(*world, "left-0"))));
+}
+
 TEST(RouteTracker, FollowsDelaysAndMeasuresLateness) {
   const auto world = h_crossing();
   carp::VehicleProfile vehicle;

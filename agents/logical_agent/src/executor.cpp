@@ -172,6 +172,7 @@ bool LogicalAgent::hold_position() {
     pause_before_retry();
     return false;
   }
+  if (!vertex && finish_edge(*status)) return true;
   if (!vertex) {
     set_activity(Activity::error);
     if (!position_alarm_raised_) {
@@ -200,6 +201,57 @@ bool LogicalAgent::hold_position() {
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
   release_passed(*status);  // what an earlier route left allocated and the vehicle does not need
   return true;
+}
+
+bool LogicalAgent::finish_edge(const ran::VehicleStatus& status) {
+  if (clock_.now() < finish_edge_at_ || !status.errors.empty() || !monitor_.inside(status.footprint)) return false;
+  const topology::Point position(status.pose.x, status.pose.y);
+  std::optional<topology::EntityIndex> on;
+  for (const auto entity : monitor_.held()) {
+    if (topology_->is_edge(entity) && bg::covered_by(position, topology_->footprint(entity))) on = entity;
+  }
+  if (!on) return false;
+  finish_edge_at_ = clock_.now() + kClearWayRetry;  // when this attempt fails, the next one
+  const auto& edge = topology_->edge(*on);
+  const auto& from = topology_->vertex(edge.from).position;
+  const auto& to = topology_->vertex(edge.to).position;
+  const double ahead =
+      std::cos(status.pose.theta) * (to.x() - from.x()) + std::sin(status.pose.theta) * (to.y() - from.y());
+  const auto target = !edge.bidirectional || ahead >= 0 ? edge.to : edge.from;
+  spdlog::info("vehicle '{}' stands part-way along '{}': it drives on to '{}'", vehicle_id(), edge.id,
+               topology_->id(target));
+  // The route holds the vertex it drives to; the edge it stands on it holds already.
+  const auto last_vertex = vertex_;
+  vertex_ = target;
+  auto route = plan_route(target, 0, false);
+  Status held = route ? switch_route(std::move(*route)) : Status(unexpected(route.error()));
+  if (!held) {
+    spdlog::warn("vehicle '{}' cannot drive on to '{}' yet: {}", vehicle_id(), topology_->id(target),
+                 held.error().message);
+    vertex_ = last_vertex;
+    return false;
+  }
+  const auto move = move_along(*topology_, *on, target, next_command_id(), options_.vehicle.max_speed);
+  auto verdict = ran_->move(move, options_.call_timeout);
+  if (verdict && !verdict->rejected()) {
+    pending_moves_.push_back(PendingMove{move.id, 0, watch_from_now()});
+    drive_activity_ = Activity::waiting;
+    driving_onto_ = target;
+    std::string failure;
+    const FollowResult result = follow(failure);
+    driving_onto_.reset();
+    if (result == FollowResult::arrived) return true;
+    spdlog::warn("vehicle '{}' did not drive on to '{}': {}", vehicle_id(), topology_->id(target), failure);
+  } else {
+    spdlog::warn("vehicle '{}' cannot drive on to '{}': the RAN {}", vehicle_id(), topology_->id(target),
+                 verdict ? "rejected the move: " + verdict->code + " " + verdict->reason
+                         : "did not take the move: " + verdict.error().message);
+    if (!verdict) pending_moves_.push_back(PendingMove{move.id, 0, watch_from_now()});  // cancelled by stop_vehicle
+  }
+  // Still part-way along the edge: what the route holds of the vertex ahead goes with it.
+  abandon_route();
+  vertex_ = last_vertex;
+  return false;
 }
 
 bool LogicalAgent::stranded_on(topology::EntityIndex vertex, const std::string& why) {
@@ -629,6 +681,7 @@ void LogicalAgent::end_allocation_wait() {
 
 void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
   for (const auto entity : monitor_.releasable(status.footprint, route_ ? route_->reached() : 0)) {
+    if (entity == driving_onto_) continue;  // not reached yet
     if (auto released = services_->release(vehicle_id(), entity, monitor_.granted_as(entity)); !released) {
       spdlog::warn("release of '{}' failed: {}", topology_->id(entity), released.error().message);
       continue;

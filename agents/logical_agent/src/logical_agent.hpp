@@ -175,8 +175,15 @@ class LogicalAgent {
   /// recent status shows it standing, after cancelling moves the RAN may still run), then
   /// releases what earlier routes left allocated that the vehicle does not need.
   /// Where that vertex cannot be held (another vehicle is due there next, or it is locked):
-  /// see stranded_on. \return whether it holds one now.
+  /// see stranded_on. A vehicle that stands part-way along an edge: see finish_edge.
+  /// \return whether it holds one now.
   bool hold_position();
+  /// A vehicle stopped part-way along an edge it holds (a cancel after its moves failed or
+  /// were lost), inside what it holds and without a RAN error, drives on to the end of the
+  /// edge it was heading for (the edge's `to` when one-way), once that vertex is reserved
+  /// and allocated to it: it then stands on a vertex again and works on. Tried at most every
+  /// kClearWayRetry. \return whether the vehicle holds that vertex now.
+  bool finish_edge(const ran::VehicleStatus& status);
   /// The vehicle stands on `vertex` and the routing agent refuses a hold of it (no_window,
   /// locked: `why`): it keeps the vertex reserved
   /// ahead of now (keep_standing_reserved), so that the vehicles due there wait behind it
@@ -392,6 +399,10 @@ class LogicalAgent {
   /// Since when commands of an earlier life are seen running (earlier_commands_running).
   std::optional<TimeNs> earlier_commands_since_;
   bool earlier_commands_cancelled_ = false;  ///< their cancel was sent (once)
+  TimeNs finish_edge_at_ = 0;       ///< when finish_edge may try next
+  /// While finish_edge drives onto it: the vertex its route starts on, which the vehicle has
+  /// not reached yet (release_passed must not take it for passed).
+  std::optional<topology::EntityIndex> driving_onto_;
   TimeNs clear_way_at_ = 0;         ///< when stranded_on tries to clear the way next
   /// The last drive (or route asked for) stopped because the vehicle was paused, not failed;
   /// cleared by whoever reads it.

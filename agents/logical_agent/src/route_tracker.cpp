@@ -1,5 +1,7 @@
 #include "agents/logical_agent/src/route_tracker.hpp"
 
+#include <algorithm>
+
 #include <boost/geometry.hpp>
 
 #include "agents/logical_agent/src/travel_time.hpp"
@@ -35,22 +37,24 @@ std::optional<std::size_t> RouteTracker::next_move() const {
   return edge;
 }
 
-ran::MoveCommand RouteTracker::command_move(std::size_t edge_step, const std::string& id, double max_speed) {
-  const auto& world = *topology_;
-  const auto target = steps_.at(edge_step + 1).entity;
+ran::MoveCommand move_along(const topology::Topology& world, topology::EntityIndex edge_index,
+                            topology::EntityIndex target, const std::string& id, double max_speed) {
+  const auto& edge = world.edge(edge_index);
   const auto& vertex = world.vertex(target);
   ran::MoveCommand move;
   move.id = id;
   move.target_vertex = world.id(target);
   move.target = ran::TargetPose{vertex.position.x(), vertex.position.y(), vertex.orientation};
-  move.edge = world.id(steps_.at(edge_step).entity);
-  // The edge's own limit and its restriction's, as the RAN checks them (ran/src/validation.cpp).
-  const auto& edge = world.edge(steps_.at(edge_step).entity);
+  move.edge = edge.id;
   move.max_speed = std::min(max_speed, edge.max_speed);
   if (edge.restrictions.max_speed) move.max_speed = std::min(move.max_speed, *edge.restrictions.max_speed);
-  for (std::size_t i = edge_step - 1; i <= edge_step + 1; ++i) {
-    move.area.push_back(world.footprint(steps_.at(i).entity));
-  }
+  const auto other_end = edge.from == target ? edge.to : edge.from;
+  move.area = {world.footprint(other_end), world.footprint(edge_index), world.footprint(target)};
+  return move;
+}
+
+ran::MoveCommand RouteTracker::command_move(std::size_t edge_step, const std::string& id, double max_speed) {
+  auto move = move_along(*topology_, steps_.at(edge_step).entity, steps_.at(edge_step + 1).entity, id, max_speed);
   commanded_ = edge_step + 1;
   return move;
 }

@@ -17,6 +17,13 @@
 
 namespace drover::logical_agent {
 
+/// The RAN command to drive along `edge` to `target`, one of its ends, from its other end
+/// or from part-way along it: at most `max_speed`, the edge's and its restriction's limits
+/// (as the RAN checks them, ran/src/validation.cpp); its motion area the footprints of the
+/// edge and both its ends.
+ran::MoveCommand move_along(const topology::Topology& world, topology::EntityIndex edge, topology::EntityIndex target,
+                            const std::string& id, double max_speed);
+
 class RouteTracker {
  public:
   /// \pre steps alternate vertex, edge, vertex of `topology`, starting and ending at a
