@@ -146,6 +146,12 @@ int run(const LaunchArguments& arguments) {
     std::cerr << "error: " << executable.error().message << "\n";
     return kExitFailure;
   }
+  // Only now that the launch file and the clock are good: a refused launch leaves no
+  // directory behind. Before the trace, which may be written into it.
+  if (auto exists = state_dir->ensure_exists(); !exists) {
+    std::cerr << "error: " << exists.error().message << "\n";
+    return kExitBadInput;
+  }
   std::unique_ptr<launcher::TraceWriter> trace;
   if (!arguments.trace_file.empty()) {
     auto opened = launcher::TraceWriter::open(arguments.trace_file, {file->path, file->topology_file});
@@ -162,12 +168,6 @@ int run(const LaunchArguments& arguments) {
                   {"epoch", epoch},
                   {"clock_origin_unix_ns", origin}});
   }
-  // Only now that every input is good: a refused launch leaves no directory behind.
-  if (auto exists = state_dir->ensure_exists(); !exists) {
-    std::cerr << "error: " << exists.error().message << "\n";
-    return kExitBadInput;
-  }
-
   dds::ParticipantOptions participant_options;
   participant_options.domain_id = file->domain_id;
   participant_options.agent_id = "launcher-" + std::to_string(::getpid());

@@ -49,7 +49,9 @@ Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_foreve
     }
     const double ns = amount * unit->second;
     if (!std::isfinite(ns)) return unexpected(bad_time(text, allow_forever));
-    if (ns > static_cast<double>(kLatestTime - std::clamp<TimeNs>(now, 0, kLatestTime))) {
+    // In whole nanoseconds: a double near kLatestTime is off by hundreds of them.
+    if (ns >= static_cast<double>(kLatestTime) ||
+        std::llround(ns) > kLatestTime - std::clamp<TimeNs>(now, 0, kLatestTime)) {
       return unexpected(beyond_clock(text, allow_forever));
     }
     return now + static_cast<TimeNs>(std::llround(ns));

@@ -134,7 +134,10 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
       {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   // 100 simulated seconds at time factor 10: 10 s for both agents to start, discover each
   // other and trace a status, on a loaded host too.
-  auto launcher = start_launch(dir, {"--duration", "100", "--trace", (dir / "trace.jsonl").string()});
+  // The trace goes into a state directory the launch makes (made before the trace opens).
+  const auto state = dir / "run1";
+  auto launcher = start_launch(
+      dir, {"--duration", "100", "--state-dir", state.string(), "--trace", (state / "trace.jsonl").string()});
   ASSERT_TRUE(launcher.has_value());
   const auto status = launcher->wait_exit(120s);
   ASSERT_TRUE(status.has_value()) << "the launcher did not stop after --duration";
@@ -143,7 +146,7 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto out = read_file((dir / "out.txt").string());
   EXPECT_NE(out.find("summary of loop test"), std::string::npos) << out;
   EXPECT_NE(out.find("stopped on --duration 100 s"), std::string::npos) << out;
-  const auto trace = read_file((dir / "trace.jsonl").string());
+  const auto trace = read_file((state / "trace.jsonl").string());
   EXPECT_EQ(trace.rfind("{\"t\":", 0), 0u) << trace.substr(0, 200);
   EXPECT_NE(trace.find("\"type\":\"launch\""), std::string::npos);
   EXPECT_NE(trace.find("\"type\":\"ran_status\""), std::string::npos) << trace.substr(0, 400);

@@ -198,13 +198,22 @@ bool LogicalAgent::hold_position() {
   }
   position_alarm_raised_ = false;
   hold_alarm_raised_ = false;
+  critical_stop_ = false;  // it stands on a vertex again
   spdlog::info("vehicle '{}' holds '{}'", vehicle_id(), topology_->id(*vertex));
   release_passed(*status);  // what an earlier route left allocated and the vehicle does not need
   return true;
 }
 
 bool LogicalAgent::finish_edge(const ran::VehicleStatus& status) {
-  if (clock_.now() < finish_edge_at_ || !status.errors.empty() || !monitor_.inside(status.footprint)) return false;
+  const bool stopped_by_error = std::any_of(status.errors.begin(), status.errors.end(), [](const auto& error) {
+    return error.level != ran::ErrorLevel::warning;
+  });
+  // After a critical alarm (a fatal RAN error, a footprint that left its area) the vehicle
+  // moves only once someone has put it on a vertex; a paused one begins nothing.
+  if (critical_stop_ || stopped_by_error || clock_.now() < finish_edge_at_ || pause_requested() ||
+      !monitor_.inside(status.footprint)) {
+    return false;
+  }
   const topology::Point position(status.pose.x, status.pose.y);
   std::optional<topology::EntityIndex> on;
   for (const auto entity : monitor_.held()) {
@@ -235,12 +244,15 @@ bool LogicalAgent::finish_edge(const ran::VehicleStatus& status) {
   auto verdict = ran_->move(move, options_.call_timeout);
   if (verdict && !verdict->rejected()) {
     pending_moves_.push_back(PendingMove{move.id, 0, watch_from_now()});
-    drive_activity_ = Activity::waiting;
+    drive_activity_ = Activity::driving;  // no order runs: nothing can be withdrawn
     driving_onto_ = target;
     std::string failure;
     const FollowResult result = follow(failure);
     driving_onto_.reset();
-    if (result == FollowResult::arrived) return true;
+    if (result == FollowResult::arrived) {
+      position_alarm_raised_ = false;
+      return true;
+    }
     spdlog::warn("vehicle '{}' did not drive on to '{}': {}", vehicle_id(), topology_->id(target), failure);
   } else {
     spdlog::warn("vehicle '{}' cannot drive on to '{}': the RAN {}", vehicle_id(), topology_->id(target),
@@ -561,6 +573,7 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
                                return e.level == ran::ErrorLevel::fatal;
                              });
           raise_alarm(fatal ? msg::ALARM_CRITICAL : msg::ALARM_ERROR, "vehicle '" + vehicle_id() + "': " + failure);
+          critical_stop_ = critical_stop_ || fatal;
           stop_vehicle();
           return FollowResult::failed;
         }
@@ -586,6 +599,7 @@ LogicalAgent::FollowResult LogicalAgent::follow(std::string& failure) {
         failure = fmt::format("the footprint of vehicle '{}' left its allocated area near ({:.2f}, {:.2f}) by {:.3f} m^2",
                               vehicle_id(), status->pose.x, status->pose.y, monitor_.area_outside(status->footprint));
         raise_alarm(msg::ALARM_CRITICAL, failure);
+        critical_stop_ = true;
         return FollowResult::failed;
       }
       if (auto error = check_errors(*status)) {
@@ -700,6 +714,7 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
   if (fatal != nullptr) {
     const std::string reason = "unrecoverable RAN error " + fatal->code + ": " + fatal->text;
     raise_alarm(msg::ALARM_CRITICAL, "vehicle '" + vehicle_id() + "': " + reason);
+    critical_stop_ = true;
     return reason;
   }
   std::string cause;

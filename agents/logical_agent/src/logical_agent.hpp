@@ -179,7 +179,8 @@ class LogicalAgent {
   /// \return whether it holds one now.
   bool hold_position();
   /// A vehicle stopped part-way along an edge it holds (a cancel after its moves failed or
-  /// were lost), inside what it holds and without a RAN error, drives on to the end of the
+  /// were lost), inside what it holds, with no RAN error (warnings aside), not paused and
+  /// not stopped by a critical alarm since it last held a vertex, drives on to the end of the
   /// edge it was heading for (the edge's `to` when one-way), once that vertex is reserved
   /// and allocated to it: it then stands on a vertex again and works on. Tried at most every
   /// kClearWayRetry. \return whether the vehicle holds that vertex now.
@@ -400,6 +401,7 @@ class LogicalAgent {
   std::optional<TimeNs> earlier_commands_since_;
   bool earlier_commands_cancelled_ = false;  ///< their cancel was sent (once)
   TimeNs finish_edge_at_ = 0;       ///< when finish_edge may try next
+  bool critical_stop_ = false;      ///< stopped by a critical alarm, not on a vertex since
   /// While finish_edge drives onto it: the vertex its route starts on, which the vehicle has
   /// not reached yet (release_passed must not take it for passed).
   std::optional<topology::EntityIndex> driving_onto_;
