@@ -535,10 +535,21 @@ class FleetTest : public ::testing::Test {
     ASSERT_EQ(send_order("V1", "pallet", {{"left-4", "load"}, {"right-4", "unload"}}), "");
     ASSERT_EQ(send_order("V1", "home", {{"left-0", "NOP"}}), "");
     const auto left4 = world_->vertex(*world_->find("left-4")).position;
+    // One command running for a second at rest on left-4: the load (20 s). The move there
+    // may still be listed running for a report after the vehicle came to rest, and a crash
+    // then would hit the load's command on its way instead of the load.
+    std::optional<std::pair<ran::CommandId, TimeNs>> resting;  // that command, since
     ASSERT_TRUE(wait_status("V1", [&](const ran::VehicleStatus& s) {
-      return std::hypot(s.pose.x - left4.x(), s.pose.y - left4.y()) < 0.05 && s.linear_speed == 0 &&
-             std::any_of(s.commands.begin(), s.commands.end(),
-                         [](const ran::CommandProgress& c) { return c.state == ran::CommandState::running; });
+      const auto running = std::find_if(s.commands.begin(), s.commands.end(), [](const ran::CommandProgress& c) {
+        return c.state == ran::CommandState::running;
+      });
+      if (std::hypot(s.pose.x - left4.x(), s.pose.y - left4.y()) >= 0.05 || s.linear_speed != 0 ||
+          running == s.commands.end()) {
+        resting.reset();
+        return false;
+      }
+      if (!resting || resting->first != running->id) resting.emplace(running->id, s.time);
+      return s.time - resting->second >= seconds_to_ns(1);
     })) << "V1 never loaded at left-4";
   }
 
