@@ -590,6 +590,20 @@ class FleetTest : public ::testing::Test {
     return ran;
   }
 
+  /// The infrastructure, V1 on left-0 with its RAN in this process (`ran`), and V1 sent to
+  /// right-4 by order `order`: returns once it drives. Call through ASSERT_NO_FATAL_FAILURE.
+  void send_v1_off_on_a_faulty_ran(Fleet& fleet, std::uint32_t domain, const std::string& order,
+                                   std::optional<InProcessRan>& ran) {
+    fleet.start_infrastructure();
+    watch(domain, fleet, {"V1"});
+    ran = start_faulty_ran(domain, "left-0");
+    ASSERT_TRUE(ran.has_value());
+    fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
+    ASSERT_TRUE(wait_ready("V1", "left-0"));
+    ASSERT_EQ(send_order("V1", order, {{"right-4", "NOP"}}), "");
+    ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  }
+
   std::shared_ptr<topology::Topology> world_;
   std::optional<SharedClock> clock_;
   Observations seen_;
@@ -1248,14 +1262,8 @@ TEST_F(FleetTest, ATopologyAgentRestartedFromItsJournalSweepsALogicalAgentThatWe
 TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
   constexpr std::uint32_t kDomain = 90;
   Fleet fleet(kDomain, "drift");
-  fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1"});
-  auto ran = start_faulty_ran(kDomain, "left-0");
-  ASSERT_TRUE(ran.has_value());
-  fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_EQ(send_order("V1", "v1-drift", {{"right-4", "NOP"}}), "");
-  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  std::optional<InProcessRan> ran;
+  ASSERT_NO_FATAL_FAILURE(send_v1_off_on_a_faulty_ran(fleet, kDomain, "v1-drift", ran));
   ran->node->runner().with_driver([&](TimeNs) { ran->driver->drift(1.5); });
 
   const auto done = wait_order("v1-drift");
@@ -1274,14 +1282,8 @@ TEST_F(FleetTest, VehicleLeavingItsAllocatedAreaIsStoppedWithACriticalAlarm) {
 TEST_F(FleetTest, ADriverThatDropsItsMovesFailsTheOrderAndTheVehicleWorksOnFromWhereItStopped) {
   constexpr std::uint32_t kDomain = 24;
   Fleet fleet(kDomain, "dropped-moves");
-  fleet.start_infrastructure();
-  watch(kDomain, fleet, {"V1"});
-  auto ran = start_faulty_ran(kDomain, "left-0");
-  ASSERT_TRUE(ran.has_value());
-  fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
-  ASSERT_TRUE(wait_ready("V1", "left-0"));
-  ASSERT_EQ(send_order("V1", "v1-dropped", {{"right-4", "NOP"}}), "");
-  ASSERT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.pose.y > 1.0; })) << "V1 never started";
+  std::optional<InProcessRan> ran;
+  ASSERT_NO_FATAL_FAILURE(send_v1_off_on_a_faulty_ran(fleet, kDomain, "v1-dropped", ran));
   // The driver stops the vehicle and forgets its moves, reporting on as if it had none
   // (before, the order stayed running and the vehicle "driving" for ever).
   std::size_t dropped = 0;
