@@ -464,7 +464,8 @@ Status LogicalAgent::switch_route(RouteTracker next) {
     if (!outcome) return unexpected(outcome.error());
     if (outcome->granted) break;
     // Not granted at once (its owner restarting, say): ask again after a tick, not in a
-    // busy loop.
+    // busy loop; a long wait is told to the operator as any wait for an allocation is.
+    note_allocation_wait(here);
     std::unique_lock lock(mutex_);
     wake_.wait_for(lock, options_.tick, [&] { return stopping_.load(); });
   }
