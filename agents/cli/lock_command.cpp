@@ -31,12 +31,19 @@ int run_lock(const LockArguments& arguments) {
     std::cerr << "error: --reason must not be empty\n";
     return kExitBadInput;
   }
-  // The times' forms are checked before anything goes on the network.
-  for (const auto& [option, text] : {std::pair{"--from", arguments.from}, std::pair{"--until", arguments.until}}) {
-    if (auto time = parse_time(text, 0, std::string(option) == "--until"); !time) {
-      std::cerr << "error: " << option << ": " << time.error().message << "\n";
-      return kExitBadInput;
-    }
+  // The times' forms are checked before anything goes on the network, and so is their
+  // order where it does not depend on the owner's clock (both absolute, or both relative).
+  const auto from_form = parse_time(arguments.from, 0, false);
+  const auto until_form = parse_time(arguments.until, 0, true);
+  if (!from_form || !until_form) {
+    std::cerr << "error: " << (from_form ? "--until: " + until_form.error().message : "--from: " + from_form.error().message)
+              << "\n";
+    return kExitBadInput;
+  }
+  if (*until_form != kForever && relative_time(arguments.from) == relative_time(arguments.until) &&
+      *from_form >= *until_form) {
+    std::cerr << "error: --from " << arguments.from << " is not before --until " << arguments.until << "\n";
+    return kExitBadInput;
   }
   auto participant = open_tool_participant(arguments.dds);
   if (!participant) {

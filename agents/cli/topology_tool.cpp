@@ -65,6 +65,8 @@ Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_foreve
   return absolute;
 }
 
+bool relative_time(const std::string& text) { return text == "now" || (!text.empty() && text[0] == '+'); }
+
 Result<dds::AgentRecord> any_topology_agent(dds::Participant& participant, std::chrono::milliseconds timeout) {
   auto directory = dds::AgentDirectory::create(participant);
   if (!directory) return unexpected(directory.error());

@@ -24,6 +24,9 @@ namespace drover::cli {
 ///         clock's range [0, kLatestTime] for a time beyond it.
 Result<TimeNs> parse_time(const std::string& text, TimeNs now, bool allow_forever);
 
+/// Whether parse_time reads `text` relative to `now` ("now", "+D").
+bool relative_time(const std::string& text);
+
 /// The live topology agent that owns `entity`, learnt from its entity description and the
 /// heartbeats, waiting at most `timeout`.
 /// \return the agent's record (its id and the shared-clock time of its last heartbeat), or

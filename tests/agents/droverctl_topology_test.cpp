@@ -218,11 +218,27 @@ TEST_F(DroverctlTopologyTest, BadInputIsExit2AndNoAgentIsExit3) {
   EXPECT_EQ(droverctl({"lock", "a", "--from", "+x", "--until", "+30s", "--reason", "r", "--domain", domain}, out, err),
             2);
   EXPECT_NE(err.find("--from: '+x' is not a time"), std::string::npos) << err;
-  EXPECT_EQ(droverctl({"lock", "a", "--from", "10", "--until", "2", "--reason", "r", "--domain", domain}, out, err), 2);
+  // Checked once the agent told what `a` is: a generous timeout for it to come up.
+  EXPECT_EQ(droverctl({"lock", "a", "--from", "10", "--until", "2", "--reason", "r", "--domain", domain, "--timeout",
+                       "20"},
+                      out, err),
+            2);
+  // Times in the wrong order are refused before any agent is asked (domain 63 has none)
+  // where the order does not depend on the owner's clock.
+  EXPECT_EQ(droverctl({"lock", "a", "--from", "10", "--until", "2", "--reason", "r", "--domain", "63", "--timeout",
+                       "1"},
+                      out, err),
+            2);
+  EXPECT_NE(err.find("--from 10 is not before --until 2"), std::string::npos) << err;
+  EXPECT_EQ(droverctl({"lock", "a", "--from", "+1m", "--until", "+30s", "--reason", "r", "--domain", "63",
+                       "--timeout", "1"},
+                      out, err),
+            2);
+  EXPECT_NE(err.find("--from +1m is not before --until +30s"), std::string::npos) << err;
   EXPECT_EQ(droverctl({"lock", "a", "--from", "1", "--until", "2", "--domain", domain}, out, err), 2)
       << "--reason is required";
   EXPECT_EQ(droverctl({"lock", "nowhere", "--from", "1", "--until", "2", "--reason", "r", "--domain", domain,
-                       "--timeout", "3"},
+                       "--timeout", "20"},
                       out, err),
             2);
   EXPECT_NE(err.find("unknown entity 'nowhere'"), std::string::npos) << err;
@@ -235,9 +251,9 @@ TEST_F(DroverctlTopologyTest, BadInputIsExit2AndNoAgentIsExit3) {
                       out, err),
             3);
   EXPECT_EQ(droverctl({"release", "a", "--domain", domain}, out, err), 2) << "--from is required";
-  EXPECT_EQ(droverctl({"release", "nowhere", "--from", "v1", "--domain", domain, "--timeout", "3"}, out, err), 2);
+  EXPECT_EQ(droverctl({"release", "nowhere", "--from", "v1", "--domain", domain, "--timeout", "20"}, out, err), 2);
   EXPECT_NE(err.find("unknown entity 'nowhere'"), std::string::npos) << err;
-  EXPECT_EQ(droverctl({"release", "a", "--from", "v1", "--domain", domain}, out, err), 1);
+  EXPECT_EQ(droverctl({"release", "a", "--from", "v1", "--domain", domain, "--timeout", "20"}, out, err), 1);
   EXPECT_NE(err.find("'v1' does not hold 'a'"), std::string::npos) << err;
   EXPECT_EQ(droverctl({"release", "a", "--from", "v1", "--domain", "63", "--timeout", "1"}, out, err), 3);
   EXPECT_EQ(droverctl({"timeline", "--help"}, out, err), 0);

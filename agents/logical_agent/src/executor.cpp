@@ -157,8 +157,11 @@ bool LogicalAgent::hold_position() {
     // Only a recent status says where the vehicle is (a RAN out of reach may have left it
     // anywhere on what it was allowed onto); that it stands, stop_vehicle saw to.
     std::lock_guard lock(mutex_);
-    if (!status_ || std::chrono::steady_clock::now() - status_received_ > kRanSilence) return false;
-    status = status_;
+    if (status_ && std::chrono::steady_clock::now() - status_received_ <= kRanSilence) status = status_;
+  }
+  if (!status) {
+    tell_refused_statuses();
+    return false;
   }
   if (earlier_commands_running(*status)) {
     set_activity(Activity::waiting);
@@ -723,7 +726,7 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
     cause = recoverable->code + ": " + recoverable->text;
   } else {
     std::lock_guard lock(mutex_);
-    if (std::chrono::steady_clock::now() - status_received_ > kRanSilence) cause = "ran_lost: no status from the RAN";
+    if (std::chrono::steady_clock::now() - status_received_ > kRanSilence) cause = silence_cause();
   }
   if (cause.empty()) {
     if (error_since_) spdlog::info("RAN error over after {}", seconds_text(clock_.now() - *error_since_));
@@ -741,6 +744,25 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
     return reason;
   }
   return std::nullopt;
+}
+
+std::string LogicalAgent::silence_cause() const {
+  const auto refusal = ran_->refusal();
+  return refusal ? "ran_status_refused: " + *refusal : "ran_lost: no status from the RAN";
+}
+
+void LogicalAgent::tell_refused_statuses() {
+  const auto refusal = ran_->refusal();
+  if (!refusal) {
+    refusal_told_.clear();  // silent (not up yet, or gone): nothing to tell but the silence
+    return;
+  }
+  set_activity(Activity::error);
+  if (*refusal == refusal_told_) return;
+  raise_alarm(msg::ALARM_ERROR, fmt::format("vehicle '{}': the statuses of its RAN are refused, so it is not "
+                                            "commanded: {}",
+                                            vehicle_id(), *refusal));
+  refusal_told_ = *refusal;
 }
 
 bool LogicalAgent::delay_at_owner(RouteTracker& route, std::size_t from_step, DurationNs by) {

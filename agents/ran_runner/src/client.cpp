@@ -66,11 +66,17 @@ Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participa
 void RanClient::receive(const msg::RanStatus& wire) {
   auto status = from_wire(wire);
   if (!status) {
-    spdlog::warn("status of vehicle '{}' ignored: {}", vehicle_id_, status.error().message);
+    std::lock_guard lock(mutex_);
+    // Logged once per reason, not ten times a second.
+    if (refusal_ != status.error().message) {
+      spdlog::warn("status of vehicle '{}' ignored: {}", vehicle_id_, status.error().message);
+    }
+    refusal_ = status.error().message;
     return;
   }
   {
     std::lock_guard lock(mutex_);
+    refusal_.reset();
     // KEEP_LAST 1 and a late join may skip reports, never reorder them; a repeated sample
     // (a replaced RAN starting over at 1) starts a new history.
     if (!history_.empty() && status->sequence <= history_.back().sequence) history_.clear();
@@ -184,6 +190,11 @@ std::optional<VehicleStatus> RanClient::wait_for(
 std::vector<VehicleStatus> RanClient::history() const {
   std::lock_guard lock(mutex_);
   return {history_.begin(), history_.end()};
+}
+
+std::optional<std::string> RanClient::refusal() const {
+  std::lock_guard lock(mutex_);
+  return refusal_;
 }
 
 }  // namespace drover::ran

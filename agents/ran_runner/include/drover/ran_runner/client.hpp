@@ -83,6 +83,10 @@ class RanClient {
                                         std::chrono::milliseconds timeout) const;
   /// The statuses received (at most the history limit), oldest first.
   std::vector<VehicleStatus> history() const;
+  /// Why the RAN's latest status was refused (a malformed message, e.g. a footprint that is
+  /// no valid polygon), when no status was taken since: such a RAN reports, yet nothing it
+  /// says is heard. nullopt when the latest status was taken, or none arrived.
+  std::optional<std::string> refusal() const;
 
   const std::string& vehicle_id() const noexcept { return vehicle_id_; }
 
@@ -106,6 +110,7 @@ class RanClient {
   StatusCallback on_status_;
   std::deque<VehicleStatus> history_;
   std::uint64_t received_ = 0;  ///< statuses received so far; history_.back() is number received_
+  std::optional<std::string> refusal_;  ///< why the latest status was refused (refusal())
   std::unique_ptr<dds::Reader<msg::RanStatus>> reader_;  // last: stopped first
 };
 
