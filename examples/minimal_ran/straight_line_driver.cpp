@@ -23,6 +23,9 @@ StraightLineDriver::StraightLineDriver(std::string vehicle_id, Pose start) : pla
   status_.vehicle_id = std::move(vehicle_id);
   status_.pose = start;
   status_.load = LoadState::empty;
+  // What it performs, advertised: an order asking this vehicle for anything else (charge,
+  // a custom action) is refused when it is sent, not failed at its destination.
+  status_.actions = {"load", "unload"};
 }
 
 void StraightLineDriver::start(StatusSink& sink, TimeNs now) {

@@ -90,4 +90,8 @@ bool VehicleStatus::has_error(const std::string& code) const {
                      [&](const VehicleError& e) { return e.code == code; });
 }
 
+bool VehicleStatus::performs(const std::string& action) const {
+  return actions.empty() || std::find(actions.begin(), actions.end(), action) != actions.end();
+}
+
 }  // namespace drover::ran

@@ -720,6 +720,8 @@ VehicleStatus SimVehicle::status() const {
   }
   status.load = load_;
   status.paused = paused_;
+  status.actions = {"load", "unload", "charge"};
+  for (const auto& [name, duration] : config_.custom_actions) status.actions.push_back(name);
   for (const Task& task : tasks_) status.commands.push_back({task.id, task.state, "", ""});
   status.commands.insert(status.commands.end(), ended_.begin(), ended_.end());
   if (battery_failed_) {

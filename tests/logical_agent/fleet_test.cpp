@@ -345,11 +345,20 @@ class FleetTest : public ::testing::Test {
         << "the topology agents' events never matched";
   }
 
-  /// Waits until the topology agent cancelled a route of `vehicle` and released every one of
-  /// `ahead` it held: the agent cancels first and releases its allocations one by one after.
-  ::testing::AssertionResult gives_up_route(const std::string& vehicle, std::initializer_list<const char*> ahead) {
+  /// How many routes of `vehicle` the topology agents reported cancelled so far.
+  std::size_t cancels_of(const std::string& vehicle) {
+    std::lock_guard lock(seen_.mutex);
+    return static_cast<std::size_t>(std::count(seen_.cancelled.begin(), seen_.cancelled.end(), vehicle));
+  }
+
+  /// Waits until the topology agent cancelled a route of `vehicle` beyond the first
+  /// `cancels_before` (cancels_of) and released every one of `ahead` it held: the agent
+  /// cancels first and releases its allocations one by one after.
+  ::testing::AssertionResult gives_up_route(const std::string& vehicle, std::size_t cancels_before,
+                                            std::initializer_list<const char*> ahead) {
     const auto cancelled = [&] {
-      return std::find(seen_.cancelled.begin(), seen_.cancelled.end(), vehicle) != seen_.cancelled.end();
+      return static_cast<std::size_t>(std::count(seen_.cancelled.begin(), seen_.cancelled.end(), vehicle)) >
+             cancels_before;
     };
     const auto still_held = [&] {
       for (const auto* entity : ahead) {
@@ -1352,8 +1361,8 @@ TEST_F(FleetTest, RefusedRanStatusesRaiseAnAlarmThatSaysWhyAndTheVehicleIsComman
   ran->node->runner().with_driver([&](TimeNs) { ran->driver->leave_out_footprint(true); });
   // Once the tester refuses them too, the last status kept for late joiners is a refused one.
   const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (!rans_["V1"]->refusal() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
-  ASSERT_TRUE(rans_["V1"]->refusal().has_value()) << "the statuses without a footprint were taken";
+  while (!rans_["V1"]->refusal(1s) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(rans_["V1"]->refusal(1s).has_value()) << "the statuses without a footprint were taken";
   fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
   EXPECT_TRUE(seen_.wait([&] { return alarm_seen(msg::ALARM_ERROR, "V1", "the statuses of its RAN are refused"); },
                          60s))
@@ -1367,6 +1376,25 @@ TEST_F(FleetTest, RefusedRanStatusesRaiseAnAlarmThatSaysWhyAndTheVehicleIsComman
   EXPECT_TRUE(wait_ready("V1", "left-0")) << "V1 was not taken over once its statuses were good";
   // Stopping the logical agent before the in-process RAN goes away.
   fleet.stop();
+}
+
+TEST_F(FleetTest, AnOrderForAnActionTheVehicleDoesNotPerformIsRefusedWhenSentAndOneItPerformsFinishes) {
+  constexpr std::uint32_t kDomain = 27;
+  Fleet fleet(kDomain, "actions");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  fleet.start_vehicle("V1", "left-0", {"--custom-action", "beep=1"});
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  // Refused at once, nothing queued (before, the vehicle drove to left-4 and failed there).
+  EXPECT_EQ(send_order("V1", "honk", {{"left-4", "honk"}}),
+            "order 'honk': destination 0: vehicle 'V1' does not perform 'honk' (its RAN performs: load, unload, "
+            "charge, beep)");
+  ASSERT_EQ(send_order("V1", "beep", {{"left-4", "beep"}}), "");
+  const auto done = wait_order("beep");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FINISHED) << done->failure();
+  std::lock_guard lock(seen_.mutex);
+  EXPECT_FALSE(seen_.orders.contains("honk")) << "the refused order was published";
 }
 
 TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
@@ -1452,6 +1480,7 @@ TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
   ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-fatal"));
+  const auto cancels = cancels_of("V1");
   ASSERT_TRUE(rans_["V1"]->inject_fault(ran::SimFault::battery_failure, 0, 10s));
 
   const auto done = wait_order("v1-fatal");
@@ -1459,7 +1488,7 @@ TEST_F(FleetTest, FatalRanErrorFailsTheOrderWithAnAlarmAndGivesUpTheRoute) {
   EXPECT_EQ(done->state(), msg::ORDER_FAILED);
   EXPECT_NE(done->failure().find("battery_failure"), std::string::npos) << done->failure();
   // The route ahead is given up on the topology agent.
-  EXPECT_TRUE(gives_up_route("V1", {"left-2", "bar-2", "right-4"}));
+  EXPECT_TRUE(gives_up_route("V1", cancels, {"left-2", "bar-2", "right-4"}));
   EXPECT_TRUE(seen_.wait([&] { return alarm_seen(msg::ALARM_CRITICAL, "V1", "battery_failure"); }, 30s))
       << "no critical alarm naming the RAN error";
 }
@@ -1470,10 +1499,11 @@ TEST_F(FleetTest, StoppedLogicalAgentStopsItsVehicleAndCancelsItsRouteAhead) {
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
   ASSERT_NO_FATAL_FAILURE(send_v1_across(fleet, "v1-shutdown"));
+  const auto cancels = cancels_of("V1");
   fleet.stop("V1");
   // The vehicle stood before the agent let go, and the reservations ahead are gone.
   EXPECT_TRUE(wait_status("V1", [](const ran::VehicleStatus& s) { return s.linear_speed == 0.0; }, 10s));
-  EXPECT_TRUE(gives_up_route("V1", {"bar-2", "right-4"}));
+  EXPECT_TRUE(gives_up_route("V1", cancels, {"bar-2", "right-4"}));
   std::lock_guard lock(seen_.mutex);
   EXPECT_LT(seen_.latest["V1"].pose.y, 6.0) << "V1 drove on after its agent stopped";
 }
@@ -1500,6 +1530,7 @@ TEST_F(FleetTest, WithdrawnOrdersEndAQueuedOneAtOnceARunningOneOnAVertexAndTheVe
   EXPECT_EQ(queued->failure(), "not needed");
   EXPECT_FALSE(queued->started().present()) << "a withdrawn queued order never starts";
 
+  const auto cancels = cancels_of("V1");
   EXPECT_EQ(droverctl(fleet, "running", {"order", "withdraw", "V1", "v1-running", "--reason", "aisle closed", "--wait",
                                          "200", "--domain", domain}, out, err), 0) << err;
   EXPECT_NE(out.find("being withdrawn"), std::string::npos) << out;
@@ -1507,7 +1538,7 @@ TEST_F(FleetTest, WithdrawnOrdersEndAQueuedOneAtOnceARunningOneOnAVertexAndTheVe
   ASSERT_TRUE(running.has_value());
   EXPECT_EQ(running->state(), msg::ORDER_WITHDRAWN) << running->failure();
   EXPECT_EQ(running->failure(), "aisle closed");
-  EXPECT_TRUE(gives_up_route("V1", {}));
+  EXPECT_TRUE(gives_up_route("V1", cancels, {}));
   // It stopped short of its destination, standing on a vertex that it holds again, not on
   // an edge.
   const auto on_held_vertex = [&] {

@@ -322,6 +322,25 @@ TEST(OrderBook, OperationsBecomeRanActions) {
   EXPECT_EQ(custom->parameters.at("height"), "1.2");
 }
 
+TEST(OrderBook, OperationsTheVehicleDoesNotPerformAreRefusedNamingWhatItDoes) {
+  const auto world = h_crossing();
+  OrderSpec spec{"o", {{"left-0", "NOP", {}}, {"left-4", "load", {}}, {"right-4", "lift", {}}, {"left-0", "park", {}}},
+                 {}};
+  const auto order = make_order(*world, spec);
+  ASSERT_TRUE(order.has_value()) << order.error().message;
+  ran::VehicleStatus status;
+  status.vehicle_id = "V1";
+  EXPECT_TRUE(check_operations(*order, status)) << "nothing advertised: the RAN decides";
+  status.actions = {"load", "unload", "lift"};
+  EXPECT_TRUE(check_operations(*order, status));
+  status.actions = {"load", "unload"};
+  const auto refused = check_operations(*order, status);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
+  EXPECT_EQ(refused.error().message,
+            "order 'o': destination 2: vehicle 'V1' does not perform 'lift' (its RAN performs: load, unload)");
+}
+
 // ---- RAN commands ----
 
 /// A status of sequence `sequence` that lists the commands `listed` (running).

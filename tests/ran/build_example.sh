@@ -33,16 +33,36 @@ status=0
 
 # launch/minimal_ran.json: the fleet of docs/ran-sdk.md, its logical agent planning with the
 # example vehicle's speed and outline; no simulated vehicle.
-"$binary_dir/bin/drover" launch "$source_dir/launch/minimal_ran.json" --domain "$domain" --state-dir "$work/state" \
-  >"$work/launch.log" 2>&1 &
+# Both end by themselves too (in 400 s, within the test's 600 s), should a SIGKILL leave them.
+"$binary_dir/bin/drover" launch "$source_dir/launch/minimal_ran.json" --domain "$domain" --duration 400 \
+  --state-dir "$work/state" >"$work/launch.log" 2>&1 &
 pids+=($!)
-"$work/build/minimal_ran" V1 "$domain" >"$work/ran.log" 2>&1 &
+timeout 400 "$work/build/minimal_ran" V1 "$domain" >"$work/ran.log" 2>&1 &
 pids+=($!)
+
+# Runs droverctl in the background: `wait` lets a TERM (the test's timeout) in at once.
+droverctl() {
+  "$binary_dir/bin/droverctl" "$@" >"$work/droverctl.out" 2>&1 &
+  local status=0
+  wait $! || status=$?
+  cat "$work/droverctl.out"
+  return $status
+}
+
 # Up to a minute for the agents to come up and answer, two for the order (about 12 m of
 # driving there and back, a load and an unload).
-if ! "$binary_dir/bin/droverctl" order send V1 left-2:load left-0:unload --name example-order --wait 120 \
-       --timeout 60 --domain "$domain"; then
+if ! droverctl order send V1 left-2:load left-0:unload --name example-order --wait 120 --timeout 60 \
+       --domain "$domain"; then
   echo "--- launch ---" >&2; cat "$work/launch.log" >&2
   echo "--- minimal_ran ---" >&2; cat "$work/ran.log" >&2
+  exit 1
+fi
+# The example advertises that it only loads and unloads: an order to charge is refused when
+# it is sent (exit 1), naming what the vehicle performs.
+status=0
+droverctl order send V1 left-2:charge --timeout 60 --domain "$domain" >/dev/null || status=$?
+refusal=$(cat "$work/droverctl.out")
+if [[ $status -ne 1 || $refusal != *"does not perform 'charge' (its RAN performs: load, unload)"* ]]; then
+  echo "an order to charge: exit $status, expected 1 and the refusal: $refusal" >&2
   exit 1
 fi

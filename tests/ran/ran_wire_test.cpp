@@ -35,6 +35,21 @@ TEST(RanStatusWire, FootprintsOfEitherWindingOpenOrClosedReadTheSame) {
   EXPECT_DOUBLE_EQ(boost::geometry::area(cw->footprint), 2.0);
 }
 
+TEST(RanStatusWire, AdvertisedActionsTravelAndNoneMeansNotAdvertised) {
+  auto wire = status_with_ring({{0, 0}, {2, 0}, {2, 1}, {0, 1}});
+  const auto silent = from_wire(wire);
+  ASSERT_TRUE(silent.has_value()) << silent.error().message;
+  EXPECT_TRUE(silent->actions.empty());
+  EXPECT_TRUE(silent->performs("anything")) << "a RAN that advertises nothing decides itself";
+  VehicleStatus status = *silent;
+  status.actions = {"load", "lift"};
+  const auto back = from_wire(to_wire(status));
+  ASSERT_TRUE(back.has_value()) << back.error().message;
+  EXPECT_EQ(back->actions, status.actions);
+  EXPECT_TRUE(back->performs("lift"));
+  EXPECT_FALSE(back->performs("charge"));
+}
+
 TEST(RanStatusWire, EmptyOrSelfCrossingFootprintsAreRefusedWithTheVehicleNamed) {
   for (const auto& ring : std::vector<std::vector<std::pair<double, double>>>{
            {}, {{0, 0}, {1, 0}}, {{0, 0}, {2, 1}, {2, 0}, {0, 1}}}) {

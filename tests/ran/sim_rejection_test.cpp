@@ -122,6 +122,13 @@ TEST_F(SimRejection, TurnLeavingTheMotionArea) {
   expect_rejected(command, rejection_code::kOutsideArea, "turning");
 }
 
+TEST_F(SimRejection, TheStatusAdvertisesTheActionsTheVehiclePerforms) {
+  const auto status = vehicle->status();
+  EXPECT_EQ(status.actions, (std::vector<std::string>{"load", "unload", "charge", "beep"}));
+  EXPECT_TRUE(status.performs("beep"));
+  EXPECT_FALSE(status.performs("dance"));
+}
+
 TEST_F(SimRejection, UnsupportedActionAndBadParameter) {
   expect_rejected(ActionCommand{"a1", ActionKind::custom, "dance", {}},
                   rejection_code::kUnsupportedAction, "'dance'");

@@ -87,7 +87,9 @@ void LogicalAgent::run() {
     }
     if (activity_ == Activity::paused) set_activity(Activity::idle);  // resumed
     const auto status = latest_status();
-    const bool battery_low = status && options_.charge_below > 0 &&
+    // A vehicle that says it does not charge (its RAN advertises its actions without
+    // "charge") is never sent to a charger: it would only fail there.
+    const bool battery_low = status && options_.charge_below > 0 && status->performs("charge") &&
                              status->battery.state_of_charge < options_.charge_below && !status->battery.charging;
     bool has_work = false;
     bool order_running = false;  // only after a restart: an order runs in execute_order otherwise
@@ -160,7 +162,8 @@ bool LogicalAgent::hold_position() {
     if (status_ && std::chrono::steady_clock::now() - status_received_ <= kRanSilence) status = status_;
   }
   if (!status) {
-    tell_refused_statuses();
+    // A RAN whose statuses are refused (told by an alarm when it began) is an error.
+    if (ran_->refusal(kRanSilence)) set_activity(Activity::error);
     return false;
   }
   if (earlier_commands_running(*status)) {
@@ -747,22 +750,8 @@ std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& 
 }
 
 std::string LogicalAgent::silence_cause() const {
-  const auto refusal = ran_->refusal();
+  const auto refusal = ran_->refusal(kRanSilence);
   return refusal ? "ran_status_refused: " + *refusal : "ran_lost: no status from the RAN";
-}
-
-void LogicalAgent::tell_refused_statuses() {
-  const auto refusal = ran_->refusal();
-  if (!refusal) {
-    refusal_told_.clear();  // silent (not up yet, or gone): nothing to tell but the silence
-    return;
-  }
-  set_activity(Activity::error);
-  if (*refusal == refusal_told_) return;
-  raise_alarm(msg::ALARM_ERROR, fmt::format("vehicle '{}': the statuses of its RAN are refused, so it is not "
-                                            "commanded: {}",
-                                            vehicle_id(), *refusal));
-  refusal_told_ = *refusal;
 }
 
 bool LogicalAgent::delay_at_owner(RouteTracker& route, std::size_t from_step, DurationNs by) {

@@ -123,8 +123,14 @@ Status LogicalAgent::start() {
   if (!heartbeat) return unexpected(heartbeat.error());
   heartbeat_ = std::move(*heartbeat);
 
-  auto ran = ran::RanClient::create(*participant_, vehicle_id(), options_.ran_agent, 16,
-                                    [this](const ran::VehicleStatus& status) { on_status(status); });
+  auto ran = ran::RanClient::create(
+      *participant_, vehicle_id(), options_.ran_agent, 16, [this](const ran::VehicleStatus& status) { on_status(status); },
+      [this](const std::string& refusal) {
+        raise_alarm(msg::ALARM_ERROR,
+                    fmt::format("vehicle '{}': the statuses of its RAN are refused, so they say nothing of where it is "
+                                "or what it does: {}",
+                                vehicle_id(), refusal));
+      });
   if (!ran) return unexpected(ran.error());
   ran_ = std::move(*ran);
 
@@ -213,6 +219,14 @@ void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<m
   }
   for (const auto& property : request.properties()) spec.properties[property.name()] = property.value();
   auto order = make_order(*topology_, spec);
+  if (order) {
+    // What the vehicle cannot do is refused now, not failed at the destination after the
+    // drive. Without a status yet, the RAN decides there.
+    std::lock_guard lock(mutex_);
+    if (status_) {
+      if (Status performed = check_operations(*order, *status_); !performed) order = unexpected(performed.error());
+    }
+  }
   if (!order) {
     spdlog::warn("order refused: {}", order.error().message);
     if (auto sent = reply.send_error(order.error()); !sent) spdlog::warn("reply not sent: {}", sent.error().message);

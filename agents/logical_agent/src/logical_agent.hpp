@@ -315,9 +315,6 @@ class LogicalAgent {
   std::optional<std::string> check_errors(const ran::VehicleStatus& status);
   /// Why no status of the RAN is heard: it is silent, or what it reports is refused.
   std::string silence_cause() const;
-  /// Raises an alarm, once per reason, when the RAN reports but its statuses are refused:
-  /// the vehicle is not commanded until one is taken.
-  void tell_refused_statuses();
   void raise_alarm(msg::AlarmSeverity severity, const std::string& text);
   void set_activity(Activity activity);
   void publish_vehicle_state(bool force);
@@ -394,7 +391,6 @@ class LogicalAgent {
   std::optional<TimeNs> stop_asked_;
   bool stop_undelivered_ = false;  ///< a cancel did not reach the RAN (warned once)
   bool position_alarm_raised_ = false;
-  std::string refusal_told_;  ///< the refusal of RAN statuses an alarm told (tell_refused_statuses)
   bool hold_alarm_raised_ = false;  ///< stranded_on told the operator (until a hold again)
   /// The allocation the vehicle waits for (note_allocation_wait).
   struct AllocationWait {

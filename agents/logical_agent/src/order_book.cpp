@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include "drover/common/identifier.hpp"
 
 namespace drover::logical_agent {
@@ -50,6 +53,17 @@ Result<Order> make_order(const topology::Topology& topology, const OrderSpec& sp
     order.destinations.push_back(Destination{*entity, stop.location, stop.operation, stop.properties});
   }
   return order;
+}
+
+Status check_operations(const Order& order, const ran::VehicleStatus& status) {
+  for (std::size_t i = 0; i < order.destinations.size(); ++i) {
+    const auto& operation = order.destinations[i].operation;
+    if (!operation_action(order.destinations[i]) || status.performs(operation)) continue;
+    return fail(ErrorCode::invalid_argument,
+                fmt::format("order '{}': destination {}: vehicle '{}' does not perform '{}' (its RAN performs: {})",
+                            order.name, i, status.vehicle_id, operation, fmt::join(status.actions, ", ")));
+  }
+  return {};
 }
 
 Result<std::size_t> OrderBook::add(Order order, TimeNs now) {

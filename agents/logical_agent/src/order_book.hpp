@@ -15,6 +15,7 @@
 #include "drover/common/clock.hpp"
 #include "drover/common/result.hpp"
 #include "drover/ran/commands.hpp"
+#include "drover/ran/status.hpp"
 #include "drover/topology/model.hpp"
 
 namespace drover::logical_agent {
@@ -72,6 +73,12 @@ struct OrderSpec {
 ///         empty name, no destination, a location (by destination index) that is not a
 ///         vertex of the topology.
 Result<Order> make_order(const topology::Topology& topology, const OrderSpec& spec);
+
+/// Checks that the vehicle performs every action `order` asks for, as its RAN advertises
+/// them (`status.actions`; when it advertises none, every action passes and the RAN decides).
+/// \return invalid_argument naming the destination, the operation and what the vehicle
+///         performs.
+Status check_operations(const Order& order, const ran::VehicleStatus& status);
 
 /// Not thread-safe: the agent guards it with its mutex.
 class OrderBook {

@@ -28,11 +28,12 @@ msg::SimFaultKind fault_to_wire(SimFault fault) {
 }  // namespace
 
 RanClient::RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit,
-                     StatusCallback on_status)
+                     StatusCallback on_status, RefusalCallback on_refusal)
     : vehicle_id_(std::move(vehicle_id)),
       ran_agent_(std::move(ran_agent)),
       history_limit_(std::max<std::size_t>(history_limit, 1)),
-      on_status_(std::move(on_status)) {}
+      on_status_(std::move(on_status)),
+      on_refusal_(std::move(on_refusal)) {}
 
 RanClient::~RanClient() {
   reader_.reset();  // no callback runs after this
@@ -42,10 +43,12 @@ Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participa
                                                      std::string vehicle_id,
                                                      std::string ran_agent,
                                                      std::size_t history_limit,
-                                                     StatusCallback on_status) {
+                                                     StatusCallback on_status,
+                                                     RefusalCallback on_refusal) {
   if (ran_agent.empty()) ran_agent = ran_agent_id(vehicle_id);
   std::unique_ptr<RanClient> client(new RanClient(std::move(vehicle_id), std::move(ran_agent),
-                                                  history_limit, std::move(on_status)));
+                                                  history_limit, std::move(on_status),
+                                                  std::move(on_refusal)));
   auto commands = CommandClient::create(participant, kServiceArea, kCommandService);
   if (!commands) return unexpected(commands.error());
   client->commands_ = std::move(*commands);
@@ -66,12 +69,17 @@ Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participa
 void RanClient::receive(const msg::RanStatus& wire) {
   auto status = from_wire(wire);
   if (!status) {
-    std::lock_guard lock(mutex_);
-    // Logged once per reason, not ten times a second.
-    if (refusal_ != status.error().message) {
-      spdlog::warn("status of vehicle '{}' ignored: {}", vehicle_id_, status.error().message);
+    bool began = false;
+    {
+      std::lock_guard lock(mutex_);
+      began = !refusal_.has_value();
+      refusal_.emplace(status.error().message, std::chrono::steady_clock::now());
     }
-    refusal_ = status.error().message;
+    // Told when it begins, not ten times a second (the reasons may name a moving point).
+    if (began) {
+      spdlog::warn("status of vehicle '{}' ignored: {}", vehicle_id_, status.error().message);
+      if (on_refusal_) on_refusal_(status.error().message);
+    }
     return;
   }
   {
@@ -192,9 +200,10 @@ std::vector<VehicleStatus> RanClient::history() const {
   return {history_.begin(), history_.end()};
 }
 
-std::optional<std::string> RanClient::refusal() const {
+std::optional<std::string> RanClient::refusal(std::chrono::steady_clock::duration max_age) const {
   std::lock_guard lock(mutex_);
-  return refusal_;
+  if (!refusal_ || std::chrono::steady_clock::now() - refusal_->second > max_age) return std::nullopt;
+  return refusal_->first;
 }
 
 }  // namespace drover::ran

@@ -134,6 +134,7 @@ msg::RanStatus to_wire(const VehicleStatus& status) {
     wire.errors().push_back(entry);
   }
   wire.footprint(polygon_to_wire(status.footprint));
+  wire.actions(status.actions);
   return wire;
 }
 
@@ -172,6 +173,7 @@ Result<VehicleStatus> from_wire(const msg::RanStatus& wire) {
     status.errors.push_back({*level, error.code(), error.text()});
   }
   status.footprint = polygon_from_wire(wire.footprint());
+  status.actions = wire.actions();
   // The logical agent checks the footprint against what it allocated and releases what it
   // no longer touches: an empty or self-crossing one would pass both checks unseen.
   if (std::string why; !boost::geometry::is_valid(status.footprint, why)) {

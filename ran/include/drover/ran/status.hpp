@@ -87,11 +87,17 @@ struct VehicleStatus {
   std::vector<CommandProgress> commands;
   std::vector<VehicleError> errors;  ///< active error conditions
   topology::Polygon footprint;       ///< the area the vehicle covers at `pose`
+  /// The actions the vehicle performs: any of "load", "unload", "charge" and the names of
+  /// its custom actions. Empty: not advertised (every action is sent; it may be rejected).
+  std::vector<std::string> actions;
 
   /// The progress of a command, if it is listed.
   const CommandProgress* find_command(const CommandId& id) const;
   /// True when an error of the given code is active.
   bool has_error(const std::string& code) const;
+  /// True when `actions` lists `action` ("load", "unload", "charge" or a custom name), or
+  /// lists nothing (not advertised).
+  bool performs(const std::string& action) const;
 };
 
 }  // namespace drover::ran

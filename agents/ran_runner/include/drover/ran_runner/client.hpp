@@ -51,6 +51,10 @@ class RanClient {
   /// Called with every status received, on the client's reader thread, after it is
   /// recorded and before wait_for() sees it; it must not destroy the client.
   using StatusCallback = std::function<void(const VehicleStatus&)>;
+  /// Called with the reason, on the client's reader thread, when the RAN's statuses begin
+  /// to be refused: the first refused one after one taken (or before any). Not again while
+  /// they go on being refused, whatever each one's reason; it must not destroy the client.
+  using RefusalCallback = std::function<void(const std::string&)>;
 
   /// A client for `vehicle_id`'s RAN, whose agent id is `ran_agent` (empty: ran_agent_id()),
   /// keeping the last `history_limit` (>= 1) statuses received.
@@ -59,7 +63,8 @@ class RanClient {
                                                    std::string vehicle_id,
                                                    std::string ran_agent = {},
                                                    std::size_t history_limit = 1000,
-                                                   StatusCallback on_status = {});
+                                                   StatusCallback on_status = {},
+                                                   RefusalCallback on_refusal = {});
   ~RanClient();
 
   /// Sends a command and waits for the RAN's reply.
@@ -84,9 +89,10 @@ class RanClient {
   /// The statuses received (at most the history limit), oldest first.
   std::vector<VehicleStatus> history() const;
   /// Why the RAN's latest status was refused (a malformed message, e.g. a footprint that is
-  /// no valid polygon), when no status was taken since: such a RAN reports, yet nothing it
-  /// says is heard. nullopt when the latest status was taken, or none arrived.
-  std::optional<std::string> refusal() const;
+  /// no valid polygon), when it came within `max_age` and no status was taken since: such a
+  /// RAN reports, yet nothing it says is heard. nullopt otherwise (the latest status was
+  /// taken, none arrived, or the RAN has gone quiet since).
+  std::optional<std::string> refusal(std::chrono::steady_clock::duration max_age) const;
 
   const std::string& vehicle_id() const noexcept { return vehicle_id_; }
 
@@ -95,7 +101,7 @@ class RanClient {
   using FaultClient = dds::ServiceClient<msg::SimFaultRequest, msg::SimFaultReply>;
 
   RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit,
-            StatusCallback on_status);
+            StatusCallback on_status, RefusalCallback on_refusal);
   Result<CommandVerdict> send(msg::RanCommandRequest request, std::chrono::milliseconds timeout);
   void receive(const msg::RanStatus& status);
 
@@ -108,9 +114,11 @@ class RanClient {
   mutable std::condition_variable arrived_;
   std::size_t history_limit_;
   StatusCallback on_status_;
+  RefusalCallback on_refusal_;
   std::deque<VehicleStatus> history_;
   std::uint64_t received_ = 0;  ///< statuses received so far; history_.back() is number received_
-  std::optional<std::string> refusal_;  ///< why the latest status was refused (refusal())
+  /// Why the latest status was refused, and when; nullopt once one is taken (refusal()).
+  std::optional<std::pair<std::string, std::chrono::steady_clock::time_point>> refusal_;
   std::unique_ptr<dds::Reader<msg::RanStatus>> reader_;  // last: stopped first
 };
 
