@@ -1397,6 +1397,25 @@ TEST_F(FleetTest, AnOrderForAnActionTheVehicleDoesNotPerformIsRefusedWhenSentAnd
   EXPECT_FALSE(seen_.orders.contains("honk")) << "the refused order was published";
 }
 
+TEST_F(FleetTest, ASecondRanForOneVehicleIsRefusedWithAnAlarmAndTheVehicleWorksOnOnceItStops) {
+  constexpr std::uint32_t kDomain = 28;
+  Fleet fleet(kDomain, "twin-ran");
+  fleet.start_infrastructure();
+  watch(kDomain, fleet, {"V1"});
+  fleet.start_vehicle("V1", "left-0");
+  ASSERT_TRUE(wait_ready("V1", "left-0"));
+  // A simulator left running with the vehicle's id, elsewhere: its statuses and those of the
+  // real RAN alternate, and both would take the commands (before, nothing told).
+  fleet.start("ran-V1-twin", {"ran-sim", "--id", "V1", "--topology", fleet.topology_file(), "--at", "right-4"});
+  EXPECT_TRUE(seen_.wait([&] { return alarm_seen(msg::ALARM_ERROR, "V1", "two RANs report for this vehicle"); }, 60s))
+      << "no alarm about the second RAN";
+  fleet.stop("ran-V1-twin");
+  ASSERT_EQ(send_order("V1", "after-twin", {{"left-4", "NOP"}}), "");
+  const auto done = wait_order("after-twin");
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->state(), msg::ORDER_FINISHED) << done->failure();
+}
+
 TEST_F(FleetTest, IdleVehicleParksOnAFreeParkingVertex) {
   constexpr std::uint32_t kDomain = 91;
   Fleet fleet(kDomain, "park");

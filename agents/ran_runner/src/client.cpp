@@ -13,6 +13,10 @@ namespace drover::ran {
 
 namespace {
 
+/// How long a status writer counts as reporting after its last status (TwinWriterWatch): a
+/// RAN reports every status period, 100 ms unless configured otherwise.
+constexpr std::chrono::seconds kTwinWindow{2};
+
 msg::SimFaultKind fault_to_wire(SimFault fault) {
   switch (fault) {
     case SimFault::stall: return msg::SIM_FAULT_STALL;
@@ -33,7 +37,8 @@ RanClient::RanClient(std::string vehicle_id, std::string ran_agent, std::size_t 
       ran_agent_(std::move(ran_agent)),
       history_limit_(std::max<std::size_t>(history_limit, 1)),
       on_status_(std::move(on_status)),
-      on_refusal_(std::move(on_refusal)) {}
+      on_refusal_(std::move(on_refusal)),
+      twins_(kTwinWindow) {}
 
 RanClient::~RanClient() {
   reader_.reset();  // no callback runs after this
@@ -60,14 +65,37 @@ Result<std::unique_ptr<RanClient>> RanClient::create(dds::Participant& participa
   options.filter_parameters = {"'" + client->vehicle_id_ + "'"};
   auto reader = dds::Reader<msg::RanStatus>::create(
       participant, kStatusTopic,
-      [raw = client.get()](const msg::RanStatus& status) { raw->receive(status); }, options);
+      [raw = client.get()](const msg::RanStatus& status, const dds::SampleSource& source) {
+        raw->receive(status, source);
+      },
+      options);
   if (!reader) return unexpected(reader.error());
   client->reader_ = std::move(*reader);
   return client;
 }
 
-void RanClient::receive(const msg::RanStatus& wire) {
+void RanClient::receive(const msg::RanStatus& wire, const dds::SampleSource& source) {
   auto status = from_wire(wire);
+  TwinWriterWatch::Verdict writers;
+  {
+    std::lock_guard lock(mutex_);
+    writers = twins_.observe(source, std::chrono::steady_clock::now());
+  }
+  if (writers.kind == TwinWriterWatch::Verdict::Kind::newcomer) {
+    // A restarted RAN, or the first status of a second one: taken once the earlier writer
+    // has been quiet for the window, or refused below once they alternate.
+    spdlog::debug("status of vehicle '{}' from a new writer {} waits: {} reported within {} s", vehicle_id_,
+                  source.text(), writers.other->text(), kTwinWindow.count());
+    return;
+  }
+  if (writers.kind == TwinWriterWatch::Verdict::Kind::twins && status) {
+    // Which of the two drives the vehicle is unknown, and both take its commands: nothing
+    // either says is taken, so the commander treats the RAN as lost until one stops.
+    status = fail(ErrorCode::conflict,
+                  fmt::format("status of '{}': two RANs report for this vehicle (status writers {} and {}); "
+                              "stop the one that does not drive it",
+                              wire.vehicle_id(), writers.other->text(), source.text()));
+  }
   if (!status) {
     bool began = false;
     {

@@ -14,6 +14,7 @@
 #include "drover/dds/message_types.hpp"
 #include "drover/dds/participant.hpp"
 #include "drover/dds/qos.hpp"
+#include "drover/dds/sample_source.hpp"
 
 namespace drover::dds {
 
@@ -32,11 +33,20 @@ class Reader {
   /// Runs on the reader's own thread, one sample at a time, in arrival order; it may
   /// block and may call services.
   using Callback = std::function<void(const T&)>;
+  /// The same, told which writer each sample came from.
+  using SourcedCallback = std::function<void(const T&, const SampleSource&)>;
 
   /// \return the reader, or invalid_argument (filter rejected), or conflict (the topic
   ///         carries another type), or unavailable.
   static Result<std::unique_ptr<Reader>> create(Participant& participant, const std::string& topic,
                                                 Callback callback, ReaderOptions options = {}) {
+    return create(
+        participant, topic,
+        SourcedCallback([callback = std::move(callback)](const T& sample, const SampleSource&) { callback(sample); }),
+        std::move(options));
+  }
+  static Result<std::unique_ptr<Reader>> create(Participant& participant, const std::string& topic,
+                                                SourcedCallback callback, ReaderOptions options = {}) {
     detail::ReaderSpec spec{topic,
                             type_support<T>(),
                             options.qos,
@@ -47,8 +57,8 @@ class Reader {
     auto core = detail::ReaderCore::create(
         participant, std::move(spec),
         [callback = std::move(callback)](std::shared_ptr<void>& sample,
-                                         const eprosima::fastdds::dds::SampleInfo&) {
-          callback(*static_cast<const T*>(sample.get()));
+                                         const eprosima::fastdds::dds::SampleInfo& info) {
+          callback(*static_cast<const T*>(sample.get()), SampleSource(info.publication_handle));
         });
     if (!core) return unexpected(core.error());
     return std::unique_ptr<Reader>(new Reader(std::move(*core)));

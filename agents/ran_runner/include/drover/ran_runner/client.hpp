@@ -20,6 +20,7 @@
 #include "drover/ran/commands.hpp"
 #include "drover/ran/status.hpp"
 #include "drover/ran_runner/names.hpp"
+#include "drover/ran_runner/twin_writer_watch.hpp"
 #include "ran.h"
 
 namespace drover::ran {
@@ -103,7 +104,7 @@ class RanClient {
   RanClient(std::string vehicle_id, std::string ran_agent, std::size_t history_limit,
             StatusCallback on_status, RefusalCallback on_refusal);
   Result<CommandVerdict> send(msg::RanCommandRequest request, std::chrono::milliseconds timeout);
-  void receive(const msg::RanStatus& status);
+  void receive(const msg::RanStatus& status, const dds::SampleSource& source);
 
   std::string vehicle_id_;
   std::string ran_agent_;
@@ -119,6 +120,7 @@ class RanClient {
   std::uint64_t received_ = 0;  ///< statuses received so far; history_.back() is number received_
   /// Why the latest status was refused, and when; nullopt once one is taken (refusal()).
   std::optional<std::pair<std::string, std::chrono::steady_clock::time_point>> refusal_;
+  TwinWriterWatch twins_;  ///< a second RAN reporting for this vehicle
   std::unique_ptr<dds::Reader<msg::RanStatus>> reader_;  // last: stopped first
 };
 

@@ -1,0 +1,61 @@
+// Two RANs reporting for one vehicle against one RAN replaced by its next life
+// (agents/ran_runner/src/twin_writer_watch.cpp).
+
+#include <gtest/gtest.h>
+
+#include "drover/ran_runner/twin_writer_watch.hpp"
+
+namespace drover::ran {
+namespace {
+
+using namespace std::chrono_literals;
+using Kind = TwinWriterWatch::Verdict::Kind;
+
+dds::SampleSource writer(unsigned char id) {
+  eprosima::fastrtps::rtps::InstanceHandle_t handle;
+  handle.value[0] = id;
+  handle.value[15] = 1;
+  return dds::SampleSource(handle);
+}
+
+TEST(TwinWriterWatch, AlternatingWritersAreTwinsUntilOneStops) {
+  TwinWriterWatch watch(2s);
+  const auto t0 = TwinWriterWatch::Clock::time_point{} + 100s;
+  const auto a = writer(1), b = writer(2);
+  EXPECT_EQ(watch.observe(a, t0).kind, Kind::take);
+  // A new writer while the first one reports may be a restarted RAN or a second one: wait.
+  const auto newcomer = watch.observe(b, t0 + 100ms);
+  EXPECT_EQ(newcomer.kind, Kind::newcomer);
+  ASSERT_TRUE(newcomer.other.has_value());
+  EXPECT_TRUE(*newcomer.other == a);
+  // Back to the first writer: both are alive.
+  const auto twins = watch.observe(a, t0 + 200ms);
+  EXPECT_EQ(twins.kind, Kind::twins);
+  ASSERT_TRUE(twins.other.has_value());
+  EXPECT_TRUE(*twins.other == b);
+  EXPECT_EQ(watch.observe(b, t0 + 300ms).kind, Kind::twins);
+  // b stops: a alone again once b is out of the window.
+  EXPECT_EQ(watch.observe(a, t0 + 1s).kind, Kind::twins);
+  EXPECT_EQ(watch.observe(a, t0 + 2500ms).kind, Kind::take);
+  EXPECT_EQ(watch.observe(a, t0 + 2600ms).kind, Kind::take);
+}
+
+TEST(TwinWriterWatch, ARanReplacedByItsNextLifeIsTakenOnceTheOldOneIsQuiet) {
+  TwinWriterWatch watch(2s);
+  const auto t0 = TwinWriterWatch::Clock::time_point{} + 100s;
+  const auto old_life = writer(1), new_life = writer(2);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(watch.observe(old_life, t0 + i * 100ms).kind, Kind::take);
+  // The old life's last status (at 0.4 s) is within the window until 2.4 s.
+  for (int i = 5; i <= 24; ++i) EXPECT_EQ(watch.observe(new_life, t0 + i * 100ms).kind, Kind::newcomer) << i;
+  for (int i = 25; i < 40; ++i) EXPECT_EQ(watch.observe(new_life, t0 + i * 100ms).kind, Kind::take) << i;
+}
+
+TEST(TwinWriterWatch, SamplesOfOneWriterAreEqualAndPrintTheirGuid) {
+  EXPECT_TRUE(writer(1) == writer(1));
+  EXPECT_FALSE(writer(1) == writer(2));
+  EXPECT_NE(writer(1).text(), writer(2).text());
+  EXPECT_FALSE(writer(1).text().empty());
+}
+
+}  // namespace
+}  // namespace drover::ran
