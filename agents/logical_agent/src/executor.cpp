@@ -161,8 +161,9 @@ bool LogicalAgent::hold_position() {
     std::lock_guard lock(mutex_);
     if (status_ && std::chrono::steady_clock::now() - status_received_ <= kRanSilence) status = status_;
   }
-  if (!status) {
-    // A RAN whose statuses are refused (told by an alarm when it began) is an error.
+  // A RAN whose statuses are refused (told by an alarm when it began) is an error; while two
+  // RANs report, what their last taken status says is no ground to command either.
+  if (!status || ran_->two_rans()) {
     if (ran_->refusal(kRanSilence)) set_activity(Activity::error);
     return false;
   }
@@ -712,6 +713,9 @@ void LogicalAgent::release_passed(const ran::VehicleStatus& status) {
 }
 
 std::optional<std::string> LogicalAgent::check_errors(const ran::VehicleStatus& status) {
+  // Both RANs take what is sent to the vehicle's RAN: nothing more goes out but the cancel
+  // of what runs (the alarm went out when their statuses began to be refused).
+  if (ran_->two_rans()) return "two RANs report for vehicle '" + vehicle_id() + "'; stop the one that does not drive it";
   const ran::VehicleError* fatal = nullptr;
   const ran::VehicleError* recoverable = nullptr;
   for (const auto& error : status.errors) {
@@ -904,6 +908,13 @@ bool LogicalAgent::stop_vehicle() {
   }
   stop_asked_.reset();
   return true;
+}
+
+const ran::VehicleStatus* LogicalAgent::heard_status() const {
+  if (!status_ || std::chrono::steady_clock::now() - status_received_ > kRanSilence || ran_->refusal(kRanSilence)) {
+    return nullptr;
+  }
+  return &*status_;
 }
 
 bool LogicalAgent::fresh_and_standing(TimeNs since) const {

@@ -221,10 +221,10 @@ void LogicalAgent::on_order(const msg::OrderRequest& request, dds::ReplyHandle<m
   auto order = make_order(*topology_, spec);
   if (order) {
     // What the vehicle cannot do is refused now, not failed at the destination after the
-    // drive. Without a status yet, the RAN decides there.
+    // drive. Without a status heard now, the RAN decides there.
     std::lock_guard lock(mutex_);
-    if (status_) {
-      if (Status performed = check_operations(*order, *status_); !performed) order = unexpected(performed.error());
+    if (const auto* status = heard_status()) {
+      if (Status performed = check_operations(*order, *status); !performed) order = unexpected(performed.error());
     }
   }
   if (!order) {

@@ -311,6 +311,10 @@ class LogicalAgent {
   /// Whether the latest status is later than `since` and shows the vehicle still.
   /// \pre mutex_ is held
   bool fresh_and_standing(TimeNs since) const;
+  /// The latest status when it is recent and the RAN's statuses are not being refused:
+  /// what the RAN says now, not what a RAN said before it went quiet or was replaced.
+  /// \pre mutex_ is held
+  const ran::VehicleStatus* heard_status() const;
   /// Checks the RAN's errors. \return a failure reason once the order must fail.
   std::optional<std::string> check_errors(const ran::VehicleStatus& status);
   /// Why no status of the RAN is heard: it is silent, or what it reports is refused.

@@ -16,6 +16,8 @@ namespace {
 /// How long a status writer counts as reporting after its last status (TwinWriterWatch): a
 /// RAN reports every status period, 100 ms unless configured otherwise.
 constexpr std::chrono::seconds kTwinWindow{2};
+/// Refusals further apart than a RAN may be silent (the logical agent's 3 s) are told anew.
+constexpr std::chrono::seconds kEpisodeGap{3};
 
 msg::SimFaultKind fault_to_wire(SimFault fault) {
   switch (fault) {
@@ -81,14 +83,15 @@ void RanClient::receive(const msg::RanStatus& wire, const dds::SampleSource& sou
     std::lock_guard lock(mutex_);
     writers = twins_.observe(source, std::chrono::steady_clock::now());
   }
-  if (writers.kind == TwinWriterWatch::Verdict::Kind::newcomer) {
-    // A restarted RAN, or the first status of a second one: taken once the earlier writer
+  if (writers.kind == TwinWriterWatch::Verdict::Kind::wait) {
+    // A restarted RAN, or the first statuses of a second one: taken once the earlier writer
     // has been quiet for the window, or refused below once they alternate.
     spdlog::debug("status of vehicle '{}' from a new writer {} waits: {} reported within {} s", vehicle_id_,
                   source.text(), writers.other->text(), kTwinWindow.count());
     return;
   }
-  if (writers.kind == TwinWriterWatch::Verdict::Kind::twins && status) {
+  const bool two_rans = writers.kind == TwinWriterWatch::Verdict::Kind::twins;
+  if (two_rans) {
     // Which of the two drives the vehicle is unknown, and both take its commands: nothing
     // either says is taken, so the commander treats the RAN as lost until one stops.
     status = fail(ErrorCode::conflict,
@@ -100,8 +103,11 @@ void RanClient::receive(const msg::RanStatus& wire, const dds::SampleSource& sou
     bool began = false;
     {
       std::lock_guard lock(mutex_);
-      began = !refusal_.has_value();
-      refusal_.emplace(status.error().message, std::chrono::steady_clock::now());
+      const auto now = std::chrono::steady_clock::now();
+      // A new episode: the first refusal since a status was taken, after a pause longer
+      // than a RAN may be silent, or of the other kind (a second RAN among malformed ones).
+      began = !refusal_ || now - refusal_->when > kEpisodeGap || refusal_->two_rans != two_rans;
+      refusal_ = Refusal{status.error().message, now, two_rans};
     }
     // Told when it begins, not ten times a second (the reasons may name a moving point).
     if (began) {
@@ -230,8 +236,13 @@ std::vector<VehicleStatus> RanClient::history() const {
 
 std::optional<std::string> RanClient::refusal(std::chrono::steady_clock::duration max_age) const {
   std::lock_guard lock(mutex_);
-  if (!refusal_ || std::chrono::steady_clock::now() - refusal_->second > max_age) return std::nullopt;
-  return refusal_->first;
+  if (!refusal_ || std::chrono::steady_clock::now() - refusal_->when > max_age) return std::nullopt;
+  return refusal_->reason;
+}
+
+bool RanClient::two_rans() const {
+  std::lock_guard lock(mutex_);
+  return refusal_ && refusal_->two_rans && std::chrono::steady_clock::now() - refusal_->when <= kTwinWindow;
 }
 
 }  // namespace drover::ran

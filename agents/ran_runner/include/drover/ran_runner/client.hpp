@@ -94,6 +94,10 @@ class RanClient {
   /// RAN reports, yet nothing it says is heard. nullopt otherwise (the latest status was
   /// taken, none arrived, or the RAN has gone quiet since).
   std::optional<std::string> refusal(std::chrono::steady_clock::duration max_age) const;
+  /// Whether two RANs report for the vehicle (TwinWriterWatch): the latest status was
+  /// refused for that, within the last two seconds. Both take the commands sent to the
+  /// vehicle's RAN agent id, so a commander sends nothing but cancels meanwhile.
+  bool two_rans() const;
 
   const std::string& vehicle_id() const noexcept { return vehicle_id_; }
 
@@ -119,7 +123,12 @@ class RanClient {
   std::deque<VehicleStatus> history_;
   std::uint64_t received_ = 0;  ///< statuses received so far; history_.back() is number received_
   /// Why the latest status was refused, and when; nullopt once one is taken (refusal()).
-  std::optional<std::pair<std::string, std::chrono::steady_clock::time_point>> refusal_;
+  struct Refusal {
+    std::string reason;
+    std::chrono::steady_clock::time_point when;
+    bool two_rans = false;  ///< refused because two RANs report
+  };
+  std::optional<Refusal> refusal_;
   TwinWriterWatch twins_;  ///< a second RAN reporting for this vehicle
   std::unique_ptr<dds::Reader<msg::RanStatus>> reader_;  // last: stopped first
 };

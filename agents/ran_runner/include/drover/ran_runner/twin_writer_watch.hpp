@@ -5,7 +5,8 @@
 // a new writer too, but the old one never reports again. That difference is what this
 // watch looks at. Until the old writer has been quiet for the window, a new one may be
 // either: its statuses wait (the first status of a second RAN, taken, would put the
-// vehicle where that RAN's vehicle is).
+// vehicle where that RAN's vehicle is). One switch back (B A B) may be a late sample of
+// the old writer; twins switch back again and again (A B A B).
 
 #include <chrono>
 #include <optional>
@@ -27,11 +28,11 @@ class TwinWriterWatch {
 
   struct Verdict {
     enum class Kind {
-      take,      ///< the only writer reporting
-      newcomer,  ///< a new writer while an earlier one reported within the window: wait
-      twins,     ///< two writers alternated within the window: two RANs report
+      take,   ///< the only writer reporting
+      wait,   ///< another writer reported within the window: a restart, or not yet known
+      twins,  ///< the writers switched back twice within the window: two RANs report
     } kind = Kind::take;
-    std::optional<dds::SampleSource> other;  ///< the other writer (newcomer, twins)
+    std::optional<dds::SampleSource> other;  ///< the other writer (wait, twins)
   };
 
   /// Notes a status written by `source` at `now`. \return what to make of it.
@@ -41,7 +42,8 @@ class TwinWriterWatch {
   Clock::duration window_;
   std::vector<std::pair<dds::SampleSource, Clock::time_point>> recent_;  ///< writer, last status
   std::optional<dds::SampleSource> last_;                                ///< writer of the last status
-  Clock::time_point alternated_until_{};                                 ///< twins seen until then
+  std::optional<Clock::time_point> switched_back_;                       ///< the last switch back
+  Clock::time_point twins_until_{};                                      ///< twins seen until then
 };
 
 }  // namespace drover::ran
