@@ -1409,10 +1409,14 @@ TEST_F(FleetTest, ASecondRanForOneVehicleIsRefusedWithAnAlarmAndTheVehicleWorksO
   fleet.start("ran-V1-twin", {"ran-sim", "--id", "V1", "--topology", fleet.topology_file(), "--at", "right-4"});
   EXPECT_TRUE(seen_.wait([&] { return alarm_seen(msg::ALARM_ERROR, "V1", "two RANs report for this vehicle"); }, 60s))
       << "no alarm about the second RAN";
-  // An order meanwhile would fail at once ("two RANs report for vehicle 'V1'"). Once the
-  // second one stops, V1's statuses are taken again, the agent's too within milliseconds.
+  // An order meanwhile would fail at once ("two RANs report for vehicle 'V1'"). The tester
+  // tells the two apart too (so that it has seen the twin's statuses the agent saw); once
+  // the second one stops, V1's statuses are taken again, the agent's within milliseconds.
+  auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (!rans_["V1"]->two_rans() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(rans_["V1"]->two_rans()) << "the tester did not see two RANs";
   fleet.stop("ran-V1-twin");
-  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  deadline = std::chrono::steady_clock::now() + 30s;
   while (rans_["V1"]->two_rans() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
   const TimeNs alone = clock_->now();
   ASSERT_TRUE(wait_status("V1", [&](const ran::VehicleStatus& s) { return s.time > alone + seconds_to_ns(1); }, 30s))
