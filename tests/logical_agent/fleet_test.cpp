@@ -651,6 +651,17 @@ class FleetTest : public ::testing::Test {
   std::unique_ptr<dds::ServiceClient<msg::OrderRequest, msg::OrderReply>> order_client_;
 };
 
+/// Polls `condition`, state that no callback reports (a RAN client's refusals), until it
+/// holds or `timeout` passes. \return whether it holds.
+bool poll_until(const std::function<bool()>& condition, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(10ms);
+  }
+  return true;
+}
+
 /// Runs droverctl to its end. \return its exit code (-1 if it did not end); output in out/err.
 /// Without a --timeout in `args` it gets a generous one: its defaults (2 s, 5 s) are for an
 /// operator's terminal, not for discovering a fleet on a loaded 2-core host. Commands end
@@ -1360,9 +1371,8 @@ TEST_F(FleetTest, RefusedRanStatusesRaiseAnAlarmThatSaysWhyAndTheVehicleIsComman
   // the agent only said "no status from the RAN", if anything).
   ran->node->runner().with_driver([&](TimeNs) { ran->driver->leave_out_footprint(true); });
   // Once the tester refuses them too, the last status kept for late joiners is a refused one.
-  const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (!rans_["V1"]->refusal(1s) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
-  ASSERT_TRUE(rans_["V1"]->refusal(1s).has_value()) << "the statuses without a footprint were taken";
+  ASSERT_TRUE(poll_until([&] { return rans_["V1"]->refusal(1s).has_value(); }, 30s))
+      << "the statuses without a footprint were taken";
   fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
   EXPECT_TRUE(seen_.wait([&] { return alarm_seen(msg::ALARM_ERROR, "V1", "the statuses of its RAN are refused"); },
                          60s))
@@ -1412,12 +1422,9 @@ TEST_F(FleetTest, ASecondRanForOneVehicleIsRefusedWithAnAlarmAndTheVehicleWorksO
   // An order meanwhile would fail at once ("two RANs report for vehicle 'V1'"). The tester
   // tells the two apart too (so that it has seen the twin's statuses the agent saw); once
   // the second one stops, V1's statuses are taken again, the agent's within milliseconds.
-  auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (!rans_["V1"]->two_rans() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(10ms);
-  ASSERT_TRUE(rans_["V1"]->two_rans()) << "the tester did not see two RANs";
+  ASSERT_TRUE(poll_until([&] { return rans_["V1"]->two_rans(); }, 30s)) << "the tester did not see two RANs";
   fleet.stop("ran-V1-twin");
-  deadline = std::chrono::steady_clock::now() + 30s;
-  while (rans_["V1"]->two_rans() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+  poll_until([&] { return !rans_["V1"]->two_rans(); }, 30s);  // the status wait below says if not
   const TimeNs alone = clock_->now();
   ASSERT_TRUE(wait_status("V1", [&](const ran::VehicleStatus& s) { return s.time > alone + seconds_to_ns(1); }, 30s))
       << "V1's statuses are not taken again";

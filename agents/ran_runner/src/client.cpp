@@ -86,8 +86,10 @@ void RanClient::receive(const msg::RanStatus& wire, const dds::SampleSource& sou
   if (writers.kind == TwinWriterWatch::Verdict::Kind::wait) {
     // A restarted RAN, or the first statuses of a second one: taken once the earlier writer
     // has been quiet for the window, or refused below once they alternate.
-    spdlog::debug("status of vehicle '{}' from a new writer {} waits: {} reported within {} s", vehicle_id_,
-                  source.text(), writers.other->text(), kTwinWindow.count());
+    if (spdlog::should_log(spdlog::level::debug)) {  // the GUIDs are formatted only when logged
+      spdlog::debug("status of vehicle '{}' from writer {} waits: {} reported within {} s", vehicle_id_,
+                    source.text(), writers.other->text(), kTwinWindow.count());
+    }
     return;
   }
   const bool two_rans = writers.kind == TwinWriterWatch::Verdict::Kind::twins;
