@@ -101,7 +101,8 @@ TEST(LauncherProcess, AgentsEndWhenTheLauncherIsKilled) {
   write_text(dir / "fleet.json", loop_launch(79, R"(
       {"kind": "topology"},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
-  auto launcher = start_launch(dir);
+  // A killed launcher cannot remove a temporary state directory: it gets one in ours.
+  auto launcher = start_launch(dir, {"--state-dir", (dir / "state").string()});
   ASSERT_TRUE(launcher.has_value());
   const auto err = dir / "err.txt";
   ASSERT_TRUE(wait_for_output(err, [](const std::string& text) {

@@ -71,7 +71,17 @@ class Fleet {
                                        "length": 0.6, "width": 0.4})";
     origin_ = SharedClock::unix_now();
   }
-  ~Fleet() { stop(); }
+  /// Stops every agent; removes the logs when the test passed (a failed test printed them,
+  /// and keeps them under dir() for a closer look).
+  ~Fleet() {
+    stop();
+    std::error_code ignored;
+    if (::testing::Test::HasFailure()) {
+      std::cerr << "logs kept in " << dir_.string() << "\n";
+    } else {
+      std::filesystem::remove_all(dir_, ignored);
+    }
+  }
 
   SharedClock clock() const { return *SharedClock::create_at_origin(origin_, kTimeFactor, origin_); }
   const std::string& topology_file() const { return topology_file_; }
