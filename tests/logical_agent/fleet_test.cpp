@@ -1403,8 +1403,21 @@ TEST_F(FleetTest, AnOrderForAnActionTheVehicleDoesNotPerformIsRefusedWhenSentAnd
   Fleet fleet(kDomain, "actions");
   fleet.start_infrastructure();
   watch(kDomain, fleet, {"V1"});
-  fleet.start_vehicle("V1", "left-0", {"--custom-action", "beep=1"});
+  // Sent before the RAN is heard, an order is queued unchecked; it fails before the drive
+  // once the RAN says what it performs (before, it drove to left-4 and failed there).
+  fleet.start_logical("V1", {"--park-after", "-1", "--charge-below", "0"});
+  ASSERT_EQ(send_order("V1", "honk-early", {{"left-4", "honk"}}), "");
+  fleet.start_ran("V1", "left-0", {"--custom-action", "beep=1"});
+  const auto early = wait_order("honk-early");
+  ASSERT_TRUE(early.has_value());
+  EXPECT_EQ(early->state(), msg::ORDER_FAILED);
+  EXPECT_NE(early->failure().find("destination 0: vehicle 'V1' does not perform 'honk'"), std::string::npos)
+      << early->failure();
   ASSERT_TRUE(wait_ready("V1", "left-0"));
+  {
+    std::lock_guard lock(seen_.mutex);
+    for (const auto& [time, holder] : seen_.holder_log["left-1"]) EXPECT_NE(holder, "V1") << "V1 drove for it";
+  }
   // Refused at once, nothing queued (before, the vehicle drove to left-4 and failed there).
   EXPECT_EQ(send_order("V1", "honk", {{"left-4", "honk"}}),
             "order 'honk': destination 0: vehicle 'V1' does not perform 'honk' (its RAN performs: load, unload, "

@@ -468,7 +468,13 @@ Status LogicalAgent::switch_route(RouteTracker next) {
   for (;;) {
     if (stopping_) return fail(ErrorCode::unavailable, "the logical agent is shutting down");
     auto outcome = services_->allocate(vehicle_id(), here, options_.allocate_wait);
-    if (!outcome) return unexpected(outcome.error());
+    if (!outcome) {
+      // The new route will not be driven: what is left of its reservation (up to its goal,
+      // held open-ended) must not block others. Not so on shutdown above: the vertex the
+      // vehicle stands on is held by nothing else now, and the next life takes over.
+      cancel_route_quietly(next);
+      return unexpected(outcome.error());
+    }
     if (outcome->granted) break;
     // Not granted at once (its owner restarting, say): ask again after a tick, not in a
     // busy loop; a long wait is told to the operator as any wait for an allocation is.
@@ -1058,6 +1064,7 @@ void LogicalAgent::execute_order() {
     std::string name;
     bool last = false;
     std::optional<ran::CommandId> commanded;  // by an earlier life: the order was restored
+    Status performed;
     {
       std::lock_guard lock(mutex_);
       const Order* order = book_.current();
@@ -1066,10 +1073,17 @@ void LogicalAgent::execute_order() {
       name = order->name;
       last = order->destination + 1 == order->destinations.size();
       commanded = order->action_command;
+      // An order queued before the RAN was heard, or restored from the journal, was not
+      // checked against what the vehicle performs: it fails before the drive, not after it.
+      if (const auto* status = heard_status(); status && !commanded) {
+        performed = check_operations(*order, *status, order->destination);
+      }
     }
     Status done;
     if (commanded) {
       done = resume_action(*commanded, destination);  // an operation under way is completed first
+    } else if (!performed) {
+      done = std::move(performed);
     } else {
       if (end_pending_withdrawal() || paused_at(name)) return;
       stopped_for_pause_ = false;

@@ -55,8 +55,8 @@ Result<Order> make_order(const topology::Topology& topology, const OrderSpec& sp
   return order;
 }
 
-Status check_operations(const Order& order, const ran::VehicleStatus& status) {
-  for (std::size_t i = 0; i < order.destinations.size(); ++i) {
+Status check_operations(const Order& order, const ran::VehicleStatus& status, std::size_t from) {
+  for (std::size_t i = from; i < order.destinations.size(); ++i) {
     const auto& operation = order.destinations[i].operation;
     if (!operation_action(order.destinations[i]) || status.performs(operation)) continue;
     return fail(ErrorCode::invalid_argument,

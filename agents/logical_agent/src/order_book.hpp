@@ -74,11 +74,12 @@ struct OrderSpec {
 ///         vertex of the topology.
 Result<Order> make_order(const topology::Topology& topology, const OrderSpec& spec);
 
-/// Checks that the vehicle performs every action `order` asks for, as its RAN advertises
-/// them (`status.actions`; when it advertises none, every action passes and the RAN decides).
+/// Checks that the vehicle performs every action `order` asks for at its destinations from
+/// index `from` on, as its RAN advertises them (`status.actions`; when it advertises none,
+/// every action passes and the RAN decides).
 /// \return invalid_argument naming the destination, the operation and what the vehicle
 ///         performs.
-Status check_operations(const Order& order, const ran::VehicleStatus& status);
+Status check_operations(const Order& order, const ran::VehicleStatus& status, std::size_t from = 0);
 
 /// Not thread-safe: the agent guards it with its mutex.
 class OrderBook {
