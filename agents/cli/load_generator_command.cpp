@@ -100,9 +100,10 @@ int run(LoadGeneratorArguments arguments) {
                station_count, arguments.domain_id);
   dds::wait_for_shutdown();
   const auto figures = (*generator)->figures();
-  spdlog::info("load generator '{}' stopping: {} orders queued, {} refused, {} finished, {} failed, {} withdrawn",
+  spdlog::info("load generator '{}' stopping: {} orders queued, {} refused, {} finished, {} failed, {} withdrawn; "
+               "{} vehicle(s) left out",
                arguments.agent_id, figures.queued, figures.refused, figures.finished, figures.failed,
-               figures.withdrawn);
+               figures.withdrawn, figures.left_out);
   heartbeat->reset();
   generator->reset();
   participant->reset();

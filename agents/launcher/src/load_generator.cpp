@@ -119,7 +119,10 @@ void LoadGenerator::consider(const std::string& vehicle) {
   {
     std::lock_guard lock(mutex_);
     const auto state = vehicles_.find(vehicle);
-    if (state == vehicles_.end() || !free_for_work(state->second) || outstanding_.contains(vehicle)) return;
+    if (state == vehicles_.end() || !free_for_work(state->second) || outstanding_.contains(vehicle) ||
+        left_out_.contains(vehicle)) {
+      return;
+    }
     if (options_.max_orders != 0 && next_number_ > options_.max_orders) return;
     order = options_.order_prefix + "-" + std::to_string(next_number_++);
     stations = picker_.next();
@@ -140,10 +143,13 @@ void LoadGenerator::send(const std::string& vehicle, const std::string& order, c
   }
   auto reply = orders_->call(request, options_.request_timeout, vehicle);
   std::string problem;
+  bool invalid = false;  // for this vehicle, whatever the stations: the next would fail alike
   if (!reply) {
     problem = reply.error().message;
   } else if (reply->error().code() != msg::ERROR_NONE) {
-    problem = dds::from_wire(reply->error()).error().message;
+    const Error refusal = dds::from_wire(reply->error()).error();
+    problem = refusal.message;
+    invalid = refusal.code == ErrorCode::invalid_argument;
   }
   std::lock_guard lock(mutex_);
   if (problem.empty()) {
@@ -158,6 +164,12 @@ void LoadGenerator::send(const std::string& vehicle, const std::string& order, c
   ++figures_.refused;
   if (auto ours = outstanding_.find(vehicle); ours != outstanding_.end() && ours->second == order) {
     outstanding_.erase(ours);  // its next state report tries again
+  }
+  if (invalid && left_out_.insert(vehicle).second) {
+    ++figures_.left_out;
+    spdlog::error("order '{}' to '{}' refused as invalid: {}; vehicle '{}' gets no more orders", order, vehicle,
+                  problem, vehicle);
+    return;
   }
   spdlog::warn("order '{}' to '{}' not queued: {}", order, vehicle, problem);
 }

@@ -4,7 +4,9 @@
 // plugin. It watches drover/logical/vehicle; a vehicle that is idle (or parking on its
 // own), has no order and none of ours outstanding gets the next order: load at one
 // station, unload at another. An order stays outstanding until its progress says it
-// finished or failed, or its request was refused.
+// finished or failed, or its request was refused. A vehicle that refuses an order as
+// invalid (it does not perform load or unload, a station is unknown to it) is left out
+// from then on: it would refuse every other order alike.
 
 #include <atomic>
 #include <chrono>
@@ -42,6 +44,7 @@ struct LoadGeneratorOptions {
 struct LoadFigures {
   std::uint64_t queued = 0;    ///< orders a logical agent accepted
   std::uint64_t refused = 0;   ///< orders refused or not answered
+  std::uint64_t left_out = 0;  ///< vehicles left out: they refused an order as invalid
   std::uint64_t finished = 0;  ///< of ours, finished
   std::uint64_t failed = 0;    ///< of ours, failed
   std::uint64_t withdrawn = 0;  ///< of ours, withdrawn (by an operator)
@@ -84,6 +87,8 @@ class LoadGenerator {
   /// Vehicles whose order failed after its load: they may still carry it, so their next
   /// order only unloads (a load on a loaded vehicle fails).
   std::set<std::string> may_carry_;
+  /// Vehicles that refused an order as invalid (invalid_argument), sent nothing more.
+  std::set<std::string> left_out_;
   std::uint64_t next_number_ = 1;
   LoadFigures figures_;
 
