@@ -250,6 +250,13 @@ TEST_F(OrderJournalTest, ADamagedRowIsRefusedNamingTableRowAndColumn) {
                                "\"properties\": {}}]', destination = 1 WHERE name = 'a'"));
   EXPECT_NE(load_error().find("row 1: column destination is out of range (1 of 1 destinations)"), std::string::npos)
       << load_error();
+  // A name no order may have (a key on the wire, bounded there): before, the agent stopped
+  // with "Not enough memory in the buffer stream" when it first published the order.
+  ASSERT_NO_FATAL_FAILURE(poke(file(), "UPDATE orders SET destination = 0, name = '" + std::string(300, 'o') +
+                                           "' WHERE name = 'a'"));
+  EXPECT_NE(load_error().find("row 1: column name is not a valid order name: order name 'ooo"), std::string::npos)
+      << load_error();
+  EXPECT_NE(load_error().find("is 300 bytes long, at most 255 are allowed"), std::string::npos) << load_error();
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/sqlite/database.hpp"
+#include "drover/common/identifier.hpp"
 
 namespace drover::logical_agent {
 
@@ -211,6 +212,12 @@ Result<std::vector<Order>> OrderJournal::load() {
         "orders", [&](sqlite::RowReader& row) {
           Order order;
           order.name = row.text(0);
+          // Names are keys on the wire, whose size Fast DDS bounds: one that make_order
+          // would refuse (written by hand, or by an older version) must not stop the agent
+          // when it is first published.
+          if (auto valid = check_identifier(order.name, "order name"); !valid) {
+            row.complain(0, "is not a valid order name: " + valid.error().message);
+          }
           if (auto destinations = parse_destinations(row.text(1))) {
             order.destinations = std::move(*destinations);
           } else {
