@@ -12,12 +12,14 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/json_line.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "drover/common/clock.hpp"
@@ -33,7 +35,7 @@ namespace {
 struct AlarmsArguments {
   DdsToolOptions dds;
   std::string min_severity = "info";
-  double duration_seconds = 0;  ///< 0: until a signal
+  std::optional<double> duration_seconds;  ///< none: until a signal
   bool json = false;
 };
 
@@ -63,12 +65,11 @@ std::string one_line(const std::string& text) {
 std::string alarm_line(const msg::OperatorAlarm& alarm, bool json) {
   const std::string severity(logical_agent::severity_name(alarm.severity()));
   if (json) {
-    return nlohmann::json{{"time_ns", alarm.time().ns()},
-                          {"agent", alarm.agent()},
-                          {"vehicle", alarm.vehicle()},
-                          {"severity", severity},
-                          {"text", alarm.text()}}
-        .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    return json_line({{"time_ns", alarm.time().ns()},
+                      {"agent", alarm.agent()},
+                      {"vehicle", alarm.vehicle()},
+                      {"severity", severity},
+                      {"text", alarm.text()}});
   }
   std::ostringstream line;
   line << std::fixed << std::setprecision(3) << ns_to_seconds(alarm.time().ns()) << " " << severity << " "
@@ -118,9 +119,11 @@ int run_alarms(const AlarmsArguments& arguments) {
     return kExitFailure;
   }
   std::cerr << "following alarms on domain " << arguments.dds.domain_id << " (Ctrl-C to stop)\n";
-  if (arguments.duration_seconds > 0) {
+  if (arguments.duration_seconds) {
+    // Whole milliseconds, at least one: --duration 0.0004 ends at once, not never.
     const auto end = std::chrono::steady_clock::now() +
-                     std::chrono::milliseconds(static_cast<std::int64_t>(arguments.duration_seconds * 1000));
+                     std::chrono::milliseconds(std::max<std::int64_t>(
+                         1, static_cast<std::int64_t>(*arguments.duration_seconds * 1000)));
     // In steps: one wait is bounded (about 24 days), the duration need not be.
     while (!dds::shutdown_requested() && std::chrono::steady_clock::now() < end) {
       dds::wait_for_shutdown(std::min<std::chrono::milliseconds>(
@@ -146,8 +149,8 @@ void add_alarms_command(CLI::App& app, CommandContext& context) {
   add_dds_tool_options(*command, arguments->dds, 0);
   command->add_option("--min-severity", arguments->min_severity,
                       "Show alarms of this severity and above: info, warning, error, critical (default info)");
-  command->add_option("--duration", arguments->duration_seconds, "Stop after S seconds (default: at Ctrl-C)")
-      ->transform(cli::non_negative());
+  command->add_option("--duration", arguments->duration_seconds, "Stop after S seconds, S > 0 (default: at Ctrl-C)")
+      ->transform(cli::positive());
   command->add_flag("--json", arguments->json, "One JSON object per alarm instead of text");
   command->callback([arguments, &context] { context.exit_code = run_alarms(*arguments); });
 }

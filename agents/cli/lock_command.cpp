@@ -95,12 +95,13 @@ int run_lock(const LockArguments& arguments) {
 void add_lock_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<LockArguments>();
   auto* command = app.add_subcommand("lock", "Lock an entity for an interval (no new reservations on it then)");
-  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required();
+  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required()->check(cli::identifier());
   command->add_option("--from", arguments->from, "Start: shared-clock ns, 'now' or '+30s' (units ns us ms s m h)")
       ->required();
   command->add_option("--until", arguments->until, "End (exclusive): as --from, or 'forever'")->required();
   command->add_option("--reason", arguments->reason, "Why (shown to operators and in the timeline)")->required();
-  command->add_option("--operator", arguments->operator_id, "Operator id (default: droverctl-<pid>)");
+  command->add_option("--operator", arguments->operator_id, "Operator id (default: droverctl-<pid>)")
+      ->check(cli::identifier());
   add_dds_tool_options(*command, arguments->dds, 5.0);
   command->callback([arguments, &context] { context.exit_code = run_lock(*arguments); });
 }

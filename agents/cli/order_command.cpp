@@ -24,6 +24,7 @@
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/cli/logical_agent_call.hpp"
 #include "drover/common/clock.hpp"
+#include "drover/common/identifier.hpp"
 #include "drover/dds/reader.hpp"
 #include "drover/dds/service_client.hpp"
 #include "drover/logical_agent/messages.hpp"
@@ -63,19 +64,22 @@ std::string end_text(const msg::OrderProgress& progress) {
   }
 }
 
-/// Waits for the terminal progress of one order.
+/// Waits for the terminal progress of one order of one vehicle.
 class ProgressWatch {
  public:
   void on_progress(const msg::OrderProgress& progress) {
     std::lock_guard lock(mutex_);
-    if (progress.order() != order_) return;
+    // Names are unique per vehicle only: another vehicle's order of the same name (ended
+    // long ago, kept for late joiners) says nothing of this one.
+    if (progress.order() != order_ || progress.vehicle() != vehicle_) return;
     if (ended(progress.state())) {
       final_ = progress;
       ended_.notify_all();
     }
   }
-  void watch(std::string order) {
+  void watch(std::string vehicle, std::string order) {
     std::lock_guard lock(mutex_);
+    vehicle_ = std::move(vehicle);
     order_ = std::move(order);
   }
   std::optional<msg::OrderProgress> wait(std::chrono::milliseconds timeout) {
@@ -87,6 +91,7 @@ class ProgressWatch {
  private:
   std::mutex mutex_;
   std::condition_variable ended_;
+  std::string vehicle_;
   std::string order_;
   std::optional<msg::OrderProgress> final_;
 };
@@ -103,14 +108,15 @@ class OrderSession {
   std::unique_ptr<dds::ServiceClient<Request, Reply>> client_;
 
   /// \return kExitOk, or the exit code after printing why it could not be opened.
-  int open(const DdsToolOptions& options, const char* service, const std::string& order, double wait_seconds) {
+  int open(const DdsToolOptions& options, const char* service, const std::string& vehicle, const std::string& order,
+           double wait_seconds) {
     auto opened = open_tool_participant(options);
     if (!opened) {
       std::cerr << "error: " << opened.error().message << "\n";
       return opened.error().code == ErrorCode::invalid_argument ? kExitBadInput : kExitFailure;
     }
     participant_ = std::move(*opened);
-    watch_.watch(order);
+    watch_.watch(vehicle, order);
     if (wait_seconds > 0) {
       auto reader = dds::Reader<msg::OrderProgress>::create(
           *participant_, logical_agent::kOrderProgressTopic,
@@ -137,7 +143,7 @@ class OrderSession {
   std::optional<Reply> ask(const DdsToolOptions& options, const char* service, const std::string& vehicle,
                            const Request& request, const std::string& order, double wait_seconds,
                            const std::string& refused, int& exit_code) {
-    exit_code = open(options, service, order, wait_seconds);
+    exit_code = open(options, service, vehicle, order, wait_seconds);
     if (exit_code != kExitOk) return std::nullopt;
     return call_logical_agent(*client_, options, vehicle, request, refused, exit_code);
   }
@@ -165,9 +171,14 @@ int send(const OrderArguments& arguments) {
   request.order(arguments.name.empty()
                     ? arguments.vehicle + "-" + std::to_string(SharedClock::unix_now())
                     : arguments.name);
+  if (auto problem = identifier_problem(request.order()); problem && arguments.name.empty()) {
+    // The default name, made from a long vehicle id: the operator never gave it.
+    std::cerr << "error: the default order name <vehicle>-<time> " << *problem << "; give one with --name\n";
+    return kExitBadInput;
+  }
   for (const auto& text : arguments.destinations) {
     const auto colon = text.rfind(':');
-    if (colon == std::string::npos || colon == 0) {
+    if (colon == std::string::npos || colon == 0 || colon + 1 == text.size()) {
       std::cerr << "error: destination '" << text << "': expected LOCATION:OPERATION (e.g. station-1:load)\n";
       return kExitBadInput;
     }
@@ -233,7 +244,7 @@ void add_order_command(CLI::App& app, CommandContext& context) {
   auto* withdraw_command = order->add_subcommand(
       "withdraw", "Withdraw an order: a queued one at once, a running one once the vehicle stands on a vertex");
   withdraw_command->add_option("vehicle", withdrawal->vehicle, "The vehicle id")->required()->check(cli::identifier());
-  withdraw_command->add_option("order", withdrawal->order, "The order's name")->required();
+  withdraw_command->add_option("order", withdrawal->order, "The order's name")->required()->check(cli::identifier());
   withdraw_command->add_option("--reason", withdrawal->reason, "Why (shown in the order's progress)");
   withdraw_command->add_option("--wait", withdrawal->wait_seconds,
                                "Also wait up to S seconds until a running order is withdrawn (exit 1 if it ends "

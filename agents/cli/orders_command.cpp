@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/json_line.hpp"
 #include "agents/cli/agent_discovery.hpp"
 #include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
@@ -102,7 +103,7 @@ int run_orders(const OrdersArguments& arguments) {
                      {"finished_ns", optional_time(progress.finished())},
                      {"failure", progress.failure()}});
     }
-    std::cout << out.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+    std::cout << json_line(out) << "\n";
     return kExitOk;
   }
   std::vector<std::vector<std::string>> rows;

@@ -54,20 +54,26 @@ std::string reason_text(const msg::VehicleState& state) {
 
 /// The vehicles `--all` asks, from the live logical agents and their states (`known`); says
 /// on standard output which it leaves as they are and why. `standing` gets the vehicles
-/// paused already (a --wait waits for them too).
+/// paused already (a --wait waits for them too); `unknown` whether a vehicle was left out
+/// because its state did not arrive (said on standard error).
 std::vector<std::string> vehicles_to_ask(const PauseArguments& arguments, bool pause,
                                          const std::vector<std::string>& live, const VehicleStates::States& known,
-                                         std::vector<std::string>& standing) {
+                                         std::vector<std::string>& standing, bool& unknown) {
   std::vector<std::string> asked;
+  unknown = false;
   for (const auto& vehicle : live) {
     const auto found = known.find(vehicle);
     if (found == known.end()) {
-      // Its state did not arrive: only a selective resume needs it.
-      if (!pause && !arguments.reason.empty()) {
-        std::cout << "vehicle '" << vehicle << "' left as it is: its state did not arrive, its pause reason is unknown\n";
-        continue;
-      }
-    } else if (pause && found->second.paused()) {
+      // Without its state, a pause could replace the reason of a pause an operator put on
+      // it alone (which a later `resume --all --reason` would then lift), and a selective
+      // resume cannot choose: it is not asked, and the command fails.
+      std::cerr << "error: vehicle '" << vehicle << "' not " << (pause ? "paused" : "resumed") << ": its state did not "
+                << "arrive within " << arguments.dds.timeout_seconds << " s, so whether it is paused already (and "
+                << "why) is unknown; try again\n";
+      unknown = true;
+      continue;
+    }
+    if (pause && found->second.paused()) {
       std::cout << "vehicle '" << vehicle << "' already paused (" << reason_text(found->second) << "): left as it is\n";
       standing.push_back(vehicle);
       continue;
@@ -141,6 +147,7 @@ int run_pause(const PauseArguments& arguments, bool pause) {
   }
   std::vector<std::string> asked{arguments.vehicle};
   std::vector<std::string> standing;  // paused already, left as they are
+  bool unknown_state = false;          // a vehicle left out: its state did not arrive
   if (arguments.all) {
     // Every live logical agent, and its vehicle's state (what decides whether it is asked).
     const auto agents = discover_live_agents(**participant, arguments.dds.timeout(), [&](const auto& records) {
@@ -158,7 +165,7 @@ int run_pause(const PauseArguments& arguments, bool pause) {
                 << arguments.dds.timeout_seconds << " s\n";
       return kExitNoAnswer;
     }
-    asked = vehicles_to_ask(arguments, pause, live, states->states(), standing);
+    asked = vehicles_to_ask(arguments, pause, live, states->states(), standing, unknown_state);
   }
   auto client = PauseClient::create(**participant, logical_agent::kServiceArea, logical_agent::kPauseService);
   if (!client) {
@@ -186,7 +193,7 @@ int run_pause(const PauseArguments& arguments, bool pause) {
       }
     }
   }
-  return failure;
+  return unknown_state ? kExitFailure : failure;
 }
 
 }  // namespace

@@ -126,7 +126,7 @@ void add_release_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<ReleaseArguments>();
   auto* command = app.add_subcommand(
       "release", "Give up an allocation that a logical agent which is gone left (refused while it is alive)");
-  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required();
+  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required()->check(cli::identifier());
   command->add_option("--from", arguments->agent, "The agent holding it (as the operator alarm names it)")
       ->required();
   add_dds_tool_options(*command, arguments->dds, 5.0);

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/json_line.hpp"
 #include "agents/cli/command.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
@@ -107,7 +108,7 @@ int run_route(const RouteArguments& arguments) {
       const auto code = status.error().code;
       exit_code = code == ErrorCode::invalid_argument || code == ErrorCode::not_found ? kExitBadInput : kExitFailure;
     } else {
-      std::cout << route_json(*reply, request.agent(), request.real()).dump() << "\n";
+      std::cout << json_line(route_json(*reply, request.agent(), request.real())) << "\n";
     }
   }
   return exit_code;
@@ -118,18 +119,21 @@ int run_route(const RouteArguments& arguments) {
 void add_route_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<RouteArguments>();
   auto* command = app.add_subcommand("route", "Ask a routing agent for a route (real unless --test), print it as JSON");
-  command->add_option("FROM", arguments->from, "Start vertex id")->required();
-  command->add_option("TO", arguments->to, "Destination vertex id")->required();
-  command->add_option("--agent", arguments->routing_agent, "Routing agent to ask (default: any)");
+  command->add_option("FROM", arguments->from, "Start vertex id")->required()->check(cli::identifier());
+  command->add_option("TO", arguments->to, "Destination vertex id")->required()->check(cli::identifier());
+  command->add_option("--agent", arguments->routing_agent, "Routing agent to ask (default: any)")
+      ->check(cli::identifier());
   command->add_flag("--test", arguments->test, "Test route: planned, nothing reserved");
-  command->add_option("--vehicle", arguments->vehicle_file, "Vehicle profile JSON file (default: carp defaults)");
+  command->add_option("--vehicle", arguments->vehicle_file, "Vehicle profile JSON file (default: carp defaults)")
+      ->check(cli::non_empty());
   command->add_option("--start-time", arguments->start_time,
                       "Shared-clock start time, ns (default: now on the routing agent's clock)")
-      ->transform(cli::exact_whole_in(0, kLatestTime));
+      ->transform(cli::exact_whole_in(1, kLatestTime));
   command->add_option("--dwell", arguments->dwell_seconds,
                       "Hold the destination this many seconds (default: open-ended, until the next route)")
       ->transform(cli::positive());
-  command->add_option("--for", arguments->owner, "Agent the route is for (default: droverctl-<pid>)");
+  command->add_option("--for", arguments->owner, "Agent the route is for (default: droverctl-<pid>)")
+      ->check(cli::identifier());
   add_dds_tool_options(*command, arguments->dds, 5.0);
   command->callback([arguments, &context] { context.exit_code = run_route(*arguments); });
 }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/json_line.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
 #include "agents/cli/topology_tool.hpp"
@@ -53,7 +54,7 @@ void print_json(const msg::TimelineState& state) {
                      {"waiting", state.waiting()},
                      {"reservations", reservations},
                      {"locks", locks}};
-  std::cout << out.dump() << "\n";
+  std::cout << json_line(out) << "\n";
 }
 
 void print_table(const msg::TimelineState& state) {
@@ -98,6 +99,8 @@ int run_timeline(const TimelineArguments& arguments) {
     return kExitFailure;
   }
   // The owner tells whether the entity exists; its timeline then comes (transient local).
+  // One --timeout bounds both waits.
+  const auto deadline = std::chrono::steady_clock::now() + arguments.dds.timeout();
   auto owner = find_owner(**participant, arguments.entity, arguments.dds.timeout());
   if (!owner) {
     std::cerr << "error: " << owner.error().message << " on domain " << arguments.dds.domain_id << " within "
@@ -107,7 +110,7 @@ int run_timeline(const TimelineArguments& arguments) {
   std::optional<msg::TimelineState> shown;
   {
     std::unique_lock lock(mutex);
-    arrived.wait_for(lock, arguments.dds.timeout(), [&] { return state.has_value(); });
+    arrived.wait_until(lock, deadline, [&] { return state.has_value(); });
     shown = state;
   }
   (*reader).reset();
@@ -130,7 +133,7 @@ void add_timeline_command(CLI::App& app, CommandContext& context) {
   auto arguments = std::make_shared<TimelineArguments>();
   auto* command = app.add_subcommand(
       "timeline", "Show an entity's timeline: reservations, locks, allocation holder and queue");
-  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required();
+  command->add_option("ENTITY", arguments->entity, "Entity id (vertex or edge)")->required()->check(cli::identifier());
   command->add_flag("--json", arguments->json, "Print one JSON object instead of a table");
   add_dds_tool_options(*command, arguments->dds, 5.0);
   command->callback([arguments, &context] { context.exit_code = run_timeline(*arguments); });

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/cli/json_line.hpp"
 #include "agents/cli/agent_discovery.hpp"
 #include "agents/cli/dds_tool_options.hpp"
 #include "agents/cli/droverctl_commands.hpp"
@@ -88,7 +89,7 @@ void print_json(const VehicleStates::States& states) {
                    {"pause_reason", state.pause_reason()},
                    {"time_ns", state.time().ns()}});
   }
-  std::cout << out.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  std::cout << json_line(out) << "\n";
 }
 
 int run_vehicles(const VehiclesArguments& arguments) {

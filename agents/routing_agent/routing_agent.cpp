@@ -353,7 +353,8 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
     }
 
     // Commit everywhere. A commit that fails (the hold expired) undoes the others. One whose
-    // reply never came may have been applied: it is undone too.
+    // reply never came, or that failed for another reason than an expired hold (its journal
+    // could not be saved), may have been applied: it is undone too.
     std::optional<Error> commit_failed;
     std::vector<PartitionShare*> to_undo;
     for (auto& share : shares) {
@@ -363,7 +364,7 @@ Result<msg::RouteReply, RoutingAgent::RouteError> RoutingAgent::serve_real(const
       Status status = done ? dds::from_wire(done->error()) : Status(unexpected(std::move(done).error()));
       if (!status) {
         commit_failed = Error{status.error().code, "commit on topology agent '" + share.owner + "': " + status.error().message};
-        if (!done) to_undo.push_back(&share);
+        if (!done || status.error().code != ErrorCode::not_found) to_undo.push_back(&share);
         break;
       }
       share.prepare_id = 0;

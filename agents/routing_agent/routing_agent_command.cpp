@@ -80,8 +80,8 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
   command->add_option("--prepare-ttl", arguments->prepare_ttl_seconds,
-                      "Shared-clock seconds a prepared hold lives before it expires (default 5)")
-      ->transform(cli::positive());
+                      "Shared-clock seconds a prepared hold lives before it expires, at most 3600 (default 5)")
+      ->transform(cli::positive_at_most(3600));
   command->add_option("--max-attempts", arguments->max_attempts,
                       "Plan/prepare rounds of a real route before ERROR_CONFLICT (default 5)")
       ->transform(cli::whole_in(1, 100));

@@ -101,6 +101,7 @@ void TopologyAgent::run_departures() {
       lock.unlock();  // the sweep takes mutex_ and calls other agents
       sweep_departed(agent, why);
       lock.lock();
+      if (departed_stop_) return;  // shutting down: the other sweeps would only delay it
       it = departed_.upper_bound(agent);  // the map may have changed meanwhile
     }
   }
@@ -112,6 +113,7 @@ std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> TopologyA
   const auto mine = served_partitions();
   for (const auto& partition : topology_.partitions()) {
     if (std::find(mine.begin(), mine.end(), partition) != mine.end()) continue;
+    if (sweep_called_off(agent)) return std::nullopt;  // each call below may take seconds
     const auto owner = directory_->live_owner_of("topology", partition);
     if (!owner) {
       spdlog::warn("what '{}' holds in partition '{}' is unknown: no live topology agent owns it", agent, partition);
@@ -129,16 +131,23 @@ std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> TopologyA
   return held;
 }
 
+bool TopologyAgent::sweep_called_off(const std::string& agent) {
+  std::lock_guard lock(departed_mutex_);
+  return departed_stop_ || alive_.contains(agent);
+}
+
 void TopologyAgent::sweep_departed(const std::string& agent, const std::string& why) {
   if (directory_) {
     if (const auto record = directory_->find(agent); record && record->alive) return;  // back just now
   }
   const auto abroad = held_abroad(agent);
+  // Asking the other partitions takes up to seconds each: an agent heard again meanwhile
+  // (a participant dropped under load and rediscovered) keeps its routes.
+  if (sweep_called_off(agent)) return;
   std::vector<std::string> kept;
   std::size_t routes = 0;
   {
     std::lock_guard lock(mutex_);
-    if (stopping_) return;
     const auto here = timelines_.holdings_of(agent);
     if (here.routes.empty()) return;
     routes = here.routes.size();

@@ -16,6 +16,14 @@ namespace drover::topology_agent {
 
 namespace {
 
+/// A prepared hold lives at most this long (shared clock): one expiring later is refused.
+/// The routing agents hold for seconds (--prepare-ttl); a later expiry means another clock
+/// (--epoch, --time-factor), and a hold whose routing agent died would block others for good.
+constexpr DurationNs kLongestHold = 3600 * kNsPerSecond;
+/// One delay moves a route at most this far: more is a unit mix-up (s for ns), which would
+/// push the route and every one behind it for years.
+constexpr DurationNs kLongestDelay = 24 * 3600 * kNsPerSecond;
+
 /// Sends a reply and logs when it could not go out (the requester went away).
 template <class Rep>
 void send_reply(dds::ReplyHandle<Rep>& handle, Rep reply) {
@@ -251,6 +259,13 @@ void TopologyAgent::on_prepare(const msg::ReservePrepareRequest& request,
     return send_error(reply, Error{ErrorCode::not_permitted, "route " + std::to_string(request.route()) + " of '" +
                                                                  request.agent() + "' was cancelled by its agent"});
   }
+  if (const TimeNs now = clock_.now(); request.expires_at() > now && request.expires_at() - now > kLongestHold) {
+    return send_error(reply, Error{ErrorCode::invalid_argument,
+                                   "hold until " + std::to_string(request.expires_at()) + " ns: more than " +
+                                       std::to_string(kLongestHold / kNsPerSecond) + " s after now on topology agent '" +
+                                       agent_id() + "' (" + std::to_string(now) +
+                                       " ns); do the agents share one clock (--epoch, --time-factor)?"});
+  }
   std::vector<topology::Reservation> items;
   std::vector<topology::EntityIndex> touched;
   for (const auto& wire_item : request.items()) {
@@ -384,7 +399,18 @@ void TopologyAgent::on_allocate(const msg::AllocateRequest& request, AllocateHan
   }
   spdlog::debug("'{}' waits for '{}' at place {}", request.agent(), request.entity(),
                 allocation->queue_position);
-  waiting_replies_.emplace(std::make_pair(request.agent(), *entity), std::move(reply));
+  const auto key = std::make_pair(request.agent(), *entity);
+  if (auto earlier = waiting_replies_.find(key); earlier != waiting_replies_.end()) {
+    // The agent asks again: its earlier call has timed out (it waits allocate_wait, then
+    // asks anew). One reply waits per agent and entity, not one per try.
+    msg::AllocateReply out;
+    out.granted(false);
+    out.queue_position(static_cast<std::uint32_t>(allocation->queue_position));
+    send_reply(earlier->second, std::move(out));
+    earlier->second = std::move(reply);
+    return;
+  }
+  waiting_replies_.emplace(key, std::move(reply));
 }
 
 void TopologyAgent::on_release(const msg::ReleaseRequest& request, StatusHandle reply) {
@@ -487,9 +513,10 @@ void TopologyAgent::on_delay(const msg::DelayRequest& request, dds::ReplyHandle<
   std::lock_guard lock(mutex_);
   auto entity = owned_entity(request.entity());
   if (!entity) return send_error(reply, entity.error());
-  if (request.by() <= 0) {
+  if (request.by() <= 0 || request.by() > kLongestDelay) {
     return send_error(reply, Error{ErrorCode::invalid_argument,
-                                   "delay of " + std::to_string(request.by()) + " ns: must be positive"});
+                                   "delay of " + std::to_string(request.by()) + " ns: must be positive and at most " +
+                                       std::to_string(kLongestDelay) + " ns (a day)"});
   }
   auto report = timelines_.delay(request.agent(), request.route(), *entity, request.by());
   if (!report) return send_error(reply, report.error());
@@ -612,10 +639,18 @@ Status TopologyAgent::after_change(const std::vector<topology::Grant>& grants,
       changed.push_back(entity);
     }
   }
+  if (journal_failed_) {
+    // What changed in memory since the failed save is neither stored nor published: the
+    // restart continues from the journal, where none of it is (a later save would store the
+    // change whose request was refused).
+    return fail(ErrorCode::unavailable, "topology agent '" + participant_->agent_id() +
+                                            "' is stopping: its journal could not be saved");
+  }
   if (journal_ && !changed.empty()) {
     if (auto saved = journal_->save(timelines_.snapshot(changed)); !saved) {
       spdlog::critical("journal not saved, stopping (a restart continues from the journal): {}",
                        saved.error().message);
+      journal_failed_ = true;
       dds::request_shutdown();
       return saved;
     }

@@ -141,9 +141,12 @@ class TopologyAgent {
   /// partition (its vehicle may stand on them or drive into them), and raises an operator
   /// alarm naming what it keeps allocated here. Takes mutex_ itself.
   void sweep_departed(const std::string& agent, const std::string& why);
+  /// Whether the sweep of `agent` is to stop: it is heard again, or the agent shuts down.
+  /// Takes departed_mutex_.
+  bool sweep_called_off(const std::string& agent);
   /// The steps `agent` holds in the other partitions, by route, asked of their owners (no
   /// lock held: they may be asking this agent at the same time). nullopt when an owner did
-  /// not answer.
+  /// not answer, or when the sweep was called off meanwhile (sweep_called_off).
   std::optional<std::map<topology::RouteId, std::vector<std::uint32_t>>> held_abroad(const std::string& agent);
 
   // The members below run with mutex_ held.
@@ -208,9 +211,12 @@ class TopologyAgent {
   std::set<std::pair<std::string, topology::RouteId>> withdrawn_;
   std::deque<std::pair<std::string, topology::RouteId>> withdrawn_order_;
   std::vector<StatusHandle> unanswered_commits_;            // drop_commit_replies
-  /// Allocation requests with wait = true that are queued: answered when granted.
-  std::multimap<std::pair<std::string, topology::EntityIndex>, AllocateHandle> waiting_replies_;
+  /// Allocation requests with wait = true that are queued, the latest per agent and entity:
+  /// answered when granted.
+  std::map<std::pair<std::string, topology::EntityIndex>, AllocateHandle> waiting_replies_;
 
+  /// A journal save failed: nothing is saved or published any more (after_change).
+  bool journal_failed_ = false;
   std::condition_variable expiry_wake_;
   bool stopping_ = false;
   std::thread expiry_thread_;

@@ -102,7 +102,8 @@ struct FakeLogicalAgent {
   std::unique_ptr<dds::HeartbeatPublisher> heartbeat;
   std::unique_ptr<dds::Writer<msg::VehicleState>> states;
 
-  FakeLogicalAgent(std::uint32_t domain, const msg::VehicleState& state) {
+  /// With `write_state` false it only beats: its state never arrives.
+  FakeLogicalAgent(std::uint32_t domain, const msg::VehicleState& state, bool write_state = true) {
     participant = make_participant(domain, state.vehicle());
     if (!participant) return;
     dds::HeartbeatOptions beat;
@@ -115,7 +116,9 @@ struct FakeLogicalAgent {
     EXPECT_TRUE(writer.has_value());
     if (!writer) return;
     states = std::move(*writer);
-    EXPECT_TRUE(states->write(state).has_value());
+    if (write_state) {
+      EXPECT_TRUE(states->write(state).has_value());
+    }
   }
   ~FakeLogicalAgent() {
     states.reset();
@@ -236,6 +239,24 @@ TEST_F(DroverctlTest, PauseAllAsksEveryLiveVehicleLeavesPausedOnesAsTheyAreAndFa
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 2) << err;
   EXPECT_NE(err.find("--reason on resume chooses among --all"), std::string::npos) << err;
+}
+
+TEST_F(DroverctlTest, PauseAndResumeAllAskNoVehicleWhoseStateDidNotArriveAndFailNamingIt) {
+  // Whether V6 is paused already (by an operator, for a reason of its own) is unknown: a
+  // fleet-wide pause would replace that reason, and a later `resume --all --reason` lift it.
+  constexpr std::uint32_t kDomain = 56;
+  const std::string domain = std::to_string(kDomain);
+  FakeLogicalAgent v6(kDomain, vehicle_state("V6", msg::VEHICLE_PAUSED, "aisle-1", "", 0.9, false), false);
+  std::string out, err;
+  for (const std::string command : {"pause", "resume"}) {
+    auto status = run_droverctl({command, "--all", "--reason", "shift change", "--domain", domain, "--timeout", "2"},
+                                out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 1) << command << ": " << out << err;
+    EXPECT_NE(err.find("error: vehicle 'V6' not " + command + "d: its state did not arrive within 2 s"),
+              std::string::npos)
+        << command << ": " << err;
+  }
 }
 
 TEST_F(DroverctlTest, VehiclesExitsWithCode3WhenNoLogicalAgentAnswers) {
@@ -374,6 +395,46 @@ TEST_F(DroverctlTest, BadUsageExitsWithCode2AndSaysWhy) {
     ASSERT_TRUE(status.has_value());
     EXPECT_EQ(status->code, 2) << from << " " << until;
     EXPECT_NE(err.find("is outside the shared clock's range"), std::string::npos) << from << " " << until << ": " << err;
+  }
+
+  // An empty operation would be sent as NOP: the vehicle would drive there and do nothing.
+  status = run_droverctl({"order", "send", "V1", "left-0:", "left-4:unload"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("destination 'left-0:': expected LOCATION:OPERATION"), std::string::npos) << err;
+
+  // A default name <vehicle>-<time> too long for a name: the operator never gave it.
+  status = run_droverctl({"order", "send", std::string(250, 'v'), "left-4:NOP"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("the default order name <vehicle>-<time> is"), std::string::npos) << err;
+  EXPECT_NE(err.find("give one with --name"), std::string::npos) << err;
+
+  // 0 would mean "until Ctrl-C": a script meant to stop would never end.
+  status = run_droverctl({"alarms", "--duration", "0"}, out, err);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->code, 2);
+  EXPECT_NE(err.find("--duration"), std::string::npos) << err;
+
+  // Empty ids would go out as "not given" (any routing agent, the default operator) or ask
+  // the network about an entity no topology can have; 0 would be sent as "now".
+  const std::vector<std::pair<std::vector<std::string>, std::string>> empty_ids{
+      {{"order", "withdraw", "V1", ""}, "order"},
+      {{"route", "left-0", "left-4", "--agent", ""}, "--agent"},
+      {{"route", "left-0", "left-4", "--for", ""}, "--for"},
+      {{"route", "left-0", "left-4", "--vehicle", ""}, "--vehicle"},
+      {{"route", "", "left-4"}, "FROM"},
+      {{"route", "left-0", "left-4", "--start-time", "0"}, "--start-time"},
+      {{"lock", "", "--from", "now", "--until", "forever", "--reason", "r"}, "ENTITY"},
+      {{"lock", "bar-3", "--from", "now", "--until", "forever", "--reason", "r", "--operator", ""}, "--operator"},
+      {{"release", "", "--from", "V1"}, "ENTITY"},
+      {{"timeline", ""}, "ENTITY"},
+  };
+  for (const auto& [args, option] : empty_ids) {
+    status = run_droverctl(args, out, err);
+    ASSERT_TRUE(status.has_value());
+    EXPECT_EQ(status->code, 2) << args[0] << " " << option << ": " << err;
+    EXPECT_NE(err.find(option), std::string::npos) << args[0] << " " << option << ": " << err;
   }
 }
 

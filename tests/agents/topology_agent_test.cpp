@@ -435,9 +435,17 @@ TEST_F(TopologyAgentTest, AllocationIsGrantedInReservationOrderHoldingsShowItAnd
     return state.holder() == "v1" && state.waiting() == std::vector<std::string>{"v2"};
   })) << "the timeline shows v1 holding b and v2 in the queue";
   EXPECT_EQ(waiting.wait_for(0s), std::future_status::timeout) << "v2 must not be granted before v1 releases";
+  // v2 asks again (as a logical agent does once its call timed out): the earlier request is
+  // answered "not yet" at once, and one reply waits, not one per try.
+  auto again = std::async(std::launch::async, [this] { return allocate("v2", "b", true); });
+  const auto superseded = waiting.get();
+  EXPECT_EQ(superseded.error().code(), msg::ERROR_NONE) << superseded.error().message();
+  EXPECT_FALSE(superseded.granted());
+  EXPECT_EQ(superseded.queue_position(), 1u);
+  EXPECT_EQ(again.wait_for(0s), std::future_status::timeout) << "v2 must not be granted before v1 releases";
 
   EXPECT_EQ(release("v1", "b").error().code(), msg::ERROR_NONE);
-  const auto granted = waiting.get();
+  const auto granted = again.get();
   EXPECT_EQ(granted.error().code(), msg::ERROR_NONE) << granted.error().message();
   EXPECT_TRUE(granted.granted());
   EXPECT_TRUE(wait_until([&] { return timelines_["b"].holder() == "v2" && timelines_["b"].waiting().empty(); }));
@@ -603,6 +611,23 @@ TEST_F(TopologyAgentTest, BadRequestsGetAnErrorReplyAndChangeNothing) {
   auto no_items = prepare_->call(prepare_request("v1", 2, {}), kDiscoveryTimeout);
   ASSERT_TRUE(no_items.has_value());
   EXPECT_EQ(no_items->error().code(), msg::ERROR_INVALID_ARGUMENT);
+
+  // A delay in seconds sent as ns would push routes for years; a hold expiring in two hours
+  // is one of another clock, and would block others for good if its routing agent died.
+  msg::DelayRequest years = backwards;
+  years.by(25 * 3600 * kNsPerSecond);
+  delayed = delay_->call(years, kDiscoveryTimeout);
+  ASSERT_TRUE(delayed.has_value());
+  EXPECT_EQ(delayed->error().code(), msg::ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(delayed->error().message().find("at most 86400000000000 ns"), std::string::npos)
+      << delayed->error().message();
+  auto far_hold = prepare_->call(
+      prepare_request("v1", 2, items("v1", 2, {{"b", {5000, 6000}}}), {}, SharedClock::wall().now() + seconds_to_ns(7200)),
+      kDiscoveryTimeout);
+  ASSERT_TRUE(far_hold.has_value());
+  EXPECT_EQ(far_hold->error().code(), msg::ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(far_hold->error().message().find("more than 3600 s after now on topology agent"), std::string::npos)
+      << far_hold->error().message();
 
   reserve("v3", 1, {{"d", {0, 10}}});
   timeline_at("d", 2);

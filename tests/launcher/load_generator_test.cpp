@@ -1,5 +1,6 @@
-// The load generator against order servers in this process (domain 29), standing in for
-// the logical agents: which vehicles it sends orders to, and what a refusal changes.
+// The load generator against order servers in this process (domains 29 and 57, one per
+// test: ctest runs them side by side), standing in for the logical agents: which vehicles it
+// sends orders to, and what a refusal changes.
 
 #include <chrono>
 #include <condition_variable>
@@ -27,12 +28,11 @@ namespace {
 using namespace std::chrono_literals;
 using OrderServer = dds::ServiceServer<msg::OrderRequest, msg::OrderReply>;
 
-constexpr std::uint32_t kDomain = 29;
 constexpr auto kTimeout = 60s;
 
-std::unique_ptr<dds::Participant> participant(const std::string& id) {
+std::unique_ptr<dds::Participant> participant(std::uint32_t domain, const std::string& id) {
   dds::ParticipantOptions options;
-  options.domain_id = kDomain;
+  options.domain_id = domain;
   options.agent_id = id;
   auto created = dds::Participant::create(options);
   EXPECT_TRUE(created.has_value()) << (created ? "" : created.error().message);
@@ -96,9 +96,10 @@ msg::VehicleState idle(const std::string& vehicle, std::int64_t time) {
 }
 
 TEST(LoadGenerator, AVehicleThatRefusesAnOrderAsInvalidGetsNoMoreWhileTheOthersDo) {
+  constexpr std::uint32_t kDomain = 29;
   Received received;
-  auto v1 = participant("V1");
-  auto v2 = participant("V2");
+  auto v1 = participant(kDomain, "V1");
+  auto v2 = participant(kDomain, "V2");
   ASSERT_TRUE(v1 && v2);
   // V1's RAN does not load: its logical agent refuses every order the generator sends.
   auto refusing = order_server(*v1, received, Error{ErrorCode::invalid_argument,
@@ -108,7 +109,7 @@ TEST(LoadGenerator, AVehicleThatRefusesAnOrderAsInvalidGetsNoMoreWhileTheOthersD
   auto states = dds::Writer<msg::VehicleState>::create(*v1, logical_agent::kVehicleStateTopic);
   ASSERT_TRUE(states.has_value()) << states.error().message;
 
-  auto generator_participant = participant("load-generator");
+  auto generator_participant = participant(kDomain, "load-generator");
   ASSERT_TRUE(generator_participant);
   launcher::LoadGeneratorOptions options;
   options.stations = {"a", "b"};
@@ -146,15 +147,16 @@ TEST(LoadGenerator, AVehicleThatRefusesAnOrderAsInvalidGetsNoMoreWhileTheOthersD
 }
 
 TEST(LoadGenerator, AVehicleThatRefusesForAnotherReasonIsTriedAgain) {
+  constexpr std::uint32_t kDomain = 57;
   Received received;
-  auto v1 = participant("V1");
+  auto v1 = participant(kDomain, "V1");
   ASSERT_TRUE(v1);
   // Not for what the order asks (its journal failed, say): the next order may be taken.
   auto refusing = order_server(*v1, received, Error{ErrorCode::unavailable, "the order journal cannot be written"});
   ASSERT_TRUE(refusing);
   auto states = dds::Writer<msg::VehicleState>::create(*v1, logical_agent::kVehicleStateTopic);
   ASSERT_TRUE(states.has_value()) << states.error().message;
-  auto generator_participant = participant("load-generator");
+  auto generator_participant = participant(kDomain, "load-generator");
   ASSERT_TRUE(generator_participant);
   launcher::LoadGeneratorOptions options;
   options.stations = {"a", "b"};

@@ -138,7 +138,7 @@ void FleetMonitor::on_progress(const msg::OrderProgress& progress) {
   if (progress.state() == msg::ORDER_WITHDRAWN) outcome = OrderOutcome::withdrawn;
   if (trace_ != nullptr) trace_->write(progress_time(progress), "order", order_line(progress));
   std::lock_guard lock(mutex_);
-  orders_.update(progress.order(), outcome, time_of(progress.created()), time_of(progress.finished()));
+  orders_.update(progress.vehicle(), progress.order(), outcome, time_of(progress.created()), time_of(progress.finished()));
 }
 
 void FleetMonitor::on_topology_event(const msg::TopologyEvent& event) {

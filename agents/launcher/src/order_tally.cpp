@@ -2,9 +2,9 @@
 
 namespace drover::launcher {
 
-void OrderTally::update(const std::string& order, OrderOutcome outcome, std::optional<TimeNs> created,
-                        std::optional<TimeNs> finished) {
-  Entry& entry = orders_[order];
+void OrderTally::update(const std::string& vehicle, const std::string& order, OrderOutcome outcome,
+                        std::optional<TimeNs> created, std::optional<TimeNs> finished) {
+  Entry& entry = orders_[{vehicle, order}];
   if (entry.outcome != OrderOutcome::open) return;
   entry.outcome = outcome;
   if (outcome == OrderOutcome::finished && created && finished) entry.lead_time = *finished - *created;
@@ -14,7 +14,7 @@ OrderFigures OrderTally::figures() const {
   OrderFigures figures;
   DurationNs lead_time_sum = 0;
   std::uint64_t timed = 0;
-  for (const auto& [name, entry] : orders_) {
+  for (const auto& [key, entry] : orders_) {
     switch (entry.outcome) {
       case OrderOutcome::open: ++figures.open; break;
       case OrderOutcome::failed: ++figures.failed; break;

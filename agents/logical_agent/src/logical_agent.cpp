@@ -365,6 +365,7 @@ void LogicalAgent::publish_progress(const Order& order) {
 void LogicalAgent::retire_progress(const std::string& name) {
   msg::OrderProgress key;
   key.order(name);
+  key.vehicle(vehicle_id());
   if (auto retired = progress_writer_->retire(key); !retired) {
     spdlog::warn("progress of forgotten order '{}' not retired: {}", name, retired.error().message);
   }

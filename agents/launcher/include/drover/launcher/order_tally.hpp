@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "drover/common/clock.hpp"
 
@@ -26,10 +27,10 @@ struct OrderFigures {
 /// Not thread-safe; the monitor guards it.
 class OrderTally {
  public:
-  /// Records the latest progress of `order`. An order that ended stays ended (a late
-  /// duplicate of an earlier state does not reopen it).
-  void update(const std::string& order, OrderOutcome outcome, std::optional<TimeNs> created,
-              std::optional<TimeNs> finished);
+  /// Records the latest progress of `vehicle`'s `order` (names are unique per vehicle). An
+  /// order that ended stays ended (a late duplicate of an earlier state does not reopen it).
+  void update(const std::string& vehicle, const std::string& order, OrderOutcome outcome,
+              std::optional<TimeNs> created, std::optional<TimeNs> finished);
   OrderFigures figures() const;
 
  private:
@@ -37,7 +38,7 @@ class OrderTally {
     OrderOutcome outcome = OrderOutcome::open;
     std::optional<DurationNs> lead_time;
   };
-  std::map<std::string, Entry> orders_;
+  std::map<std::pair<std::string, std::string>, Entry> orders_;  ///< by (vehicle, order)
 };
 
 }  // namespace drover::launcher
