@@ -42,8 +42,11 @@ double normalize_angle(double angle) {
 double turn_between(double from, double to) { return normalize_angle(to - from); }
 
 /// Seconds to nanoseconds, rounded up, so that at the returned time an event is due.
+/// `seconds` as whole ns, rounded up, at most kLatestTime: added to a time of the shared
+/// clock's range it cannot overflow (a crawl at 1e-12 m/s would last 1e13 s).
 DurationNs ceil_ns(double seconds) {
-  return static_cast<DurationNs>(std::ceil(std::max(0.0, seconds) * 1e9));
+  const double ns = std::ceil(std::max(0.0, seconds) * 1e9);
+  return ns >= static_cast<double>(kLatestTime) ? kLatestTime : static_cast<DurationNs>(ns);
 }
 
 Unexpected<Rejection> rejection(const char* code, std::string reason) {
@@ -100,6 +103,16 @@ CommandCheck SimVehicle::admit(const CommandId& id) {
   if (battery_failed_) {
     return reject(id, {rejection_code::kNotReady,
                        fmt::format("command '{}': the battery has failed", id)});
+  }
+  if (std::any_of(tasks_.begin(), tasks_.end(), [](const Task& task) { return task.cancel_requested; })) {
+    // Braking for a cancel: a command queued now would start where the cancelled ones end,
+    // and be cancelled with them once the vehicle stands. Slower than standing still, it
+    // stands (as its status may have said already): the cancel completes first.
+    if (!standing_still(speed_, angular_speed_)) {
+      return reject(id, {rejection_code::kNotReady,
+                         fmt::format("command '{}': the vehicle still brakes for a cancel; send it once it stands", id)});
+    }
+    remove_cancelled();
   }
   return {};
 }
@@ -323,7 +336,9 @@ void SimVehicle::stop_at_once() {
 }
 
 void SimVehicle::inject_stall(DurationNs duration) {
-  stalled_until_ = std::max(stalled_until_, now_ + std::max<DurationNs>(duration, 1));
+  // Saturated, as a lost connection is: a duration from the network may be anything.
+  const TimeNs until = duration >= kForever - now_ ? kForever : now_ + std::max<DurationNs>(duration, 1);
+  stalled_until_ = std::max(stalled_until_, until);
   stop_at_once();
 }
 
@@ -603,6 +618,9 @@ bool SimVehicle::finish_front_step() {
 }
 
 void SimVehicle::plan_motion() {
+  // A turn proceeds only while the vehicle may move: held (paused, stalled, ...), it turns
+  // no more and says so.
+  if (!can_move()) angular_speed_ = 0;
   const Step* step = front_step();
   const bool on_straight = step != nullptr && std::holds_alternative<Straight>(*step);
   // Faults stop the vehicle at once (and zero the speed themselves); a pause, a lost link

@@ -116,6 +116,27 @@ TEST(SimFaults, LostConnectionBrakesHoldsAndResumesWhenRestored) {
   EXPECT_TRUE(vehicle.connected());
 }
 
+TEST(SimFaults, AStallOfAnyLengthFromTheNetworkNeitherWrapsNorEndsEarly) {
+  const auto world = test::world();
+  auto vehicle = vehicle_at(world, "A");
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "A", "ab", "B", 1.0)));
+  vehicle.step(seconds_to_ns(1));
+  vehicle.inject_stall(kForever);  // before, now + duration wrapped: the stall ended at once
+  vehicle.step(seconds_to_ns(1000));
+  EXPECT_TRUE(vehicle.status().has_error("stall"));
+  EXPECT_EQ(state_of(vehicle, "m1"), CommandState::running);
+}
+
+TEST(SimMotion, AMoveAtACrawlRunsWithoutOverflowingItsEndTime) {
+  const auto world = test::world();
+  auto vehicle = vehicle_at(world, "A");
+  // 5 m at 1e-12 m/s would take 5e12 s: more ns than an int64 holds.
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "A", "ab", "B", 1e-12)));
+  vehicle.step(seconds_to_ns(10));
+  EXPECT_EQ(state_of(vehicle, "m1"), CommandState::running);
+  EXPECT_LT(vehicle.status().pose.x, 1e-9);
+}
+
 TEST(SimPause, BrakesHoldsAndResumes) {
   const auto world = test::world();
   auto vehicle = vehicle_at(world, "A");
@@ -133,6 +154,24 @@ TEST(SimPause, BrakesHoldsAndResumes) {
       vehicle, [&] { return state_of(vehicle, "m1") == CommandState::finished; }, kMs,
       seconds_to_ns(60)));
   EXPECT_NEAR(ns_to_seconds(vehicle.now()), 25 + test::trapezoid_time(2, 1, 0.5, 0.5), 0.0011);
+}
+
+TEST(SimPause, PausedMidTurnItTurnsNoMoreAndSaysSo) {
+  const auto world = test::world();
+  auto vehicle = vehicle_at(world, "C");  // facing +x; cd leads to +y: it turns first
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "C", "cd", "D", 1.0)));
+  vehicle.step(100 * kMs);
+  ASSERT_NE(vehicle.status().angular_speed, 0);
+  vehicle.pause();
+  EXPECT_EQ(vehicle.status().angular_speed, 0) << "a paused vehicle reported turning";
+  const double heading = vehicle.status().pose.theta;
+  vehicle.step(seconds_to_ns(1));
+  EXPECT_EQ(vehicle.status().angular_speed, 0);
+  EXPECT_DOUBLE_EQ(vehicle.status().pose.theta, heading);
+  vehicle.resume();
+  ASSERT_TRUE(step_until(
+      vehicle, [&] { return state_of(vehicle, "m1") == CommandState::finished; }, 10 * kMs, seconds_to_ns(60)));
+  EXPECT_NEAR(vehicle.status().pose.y, 5.0, 1e-9);
 }
 
 TEST(SimCancel, RunningMoveBrakesAndEndsCancelledWithWhatFollows) {
@@ -187,6 +226,30 @@ TEST(SimCancel, TooLateToStopBeforeTheCancelledMoveBrakesIntoIt) {
   EXPECT_EQ(state_of(vehicle, "m2"), CommandState::cancelled);
   EXPECT_NEAR(vehicle.status().pose.x, 5.5, 1e-9);
   EXPECT_EQ(vehicle.status().linear_speed, 0);
+}
+
+TEST(SimCancel, ACommandWhileBrakingForACancelIsRefusedUntilTheVehicleStandsStill) {
+  const auto world = test::world();
+  auto vehicle = vehicle_at(world, "A");
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "A", "ab", "B", 1.0)));
+  vehicle.step(seconds_to_ns(3));  // 1 m/s: braking at 0.5 m/s² takes 2 s
+  ASSERT_TRUE(vehicle.cancel("m1"));
+  // Queued now, it would start at B (where m1 ends) and be cancelled with m1 once it stands.
+  const auto early = vehicle.submit(move(*world, "early", "A", "ab", "B", 1.0));
+  ASSERT_FALSE(early);
+  EXPECT_EQ(early.error().code, rejection_code::kNotReady);
+  EXPECT_EQ(state_of(vehicle, "early"), CommandState::rejected);
+  // 1 ms before it stands its speed is 0.5 mm/s: standing still, as its status says, so the
+  // cancel completes and the next command starts where the vehicle is.
+  vehicle.step(seconds_to_ns(2) - kMs);
+  ASSERT_TRUE(standing_still(vehicle.status().linear_speed, vehicle.status().angular_speed));
+  ASSERT_GT(vehicle.status().linear_speed, 0);
+  ASSERT_TRUE(vehicle.submit(move(*world, "on", "A", "ab", "B", 1.0)));
+  EXPECT_EQ(state_of(vehicle, "m1"), CommandState::cancelled);
+  EXPECT_EQ(state_of(vehicle, "on"), CommandState::running);  // not cancelled with m1
+  ASSERT_TRUE(step_until(
+      vehicle, [&] { return state_of(vehicle, "on") == CommandState::finished; }, 10 * kMs, seconds_to_ns(60)));
+  EXPECT_DOUBLE_EQ(vehicle.status().pose.x, 5.0);
 }
 
 TEST(SimCancel, UnknownOrEndedCommandIsRefused) {

@@ -875,7 +875,8 @@ void LogicalAgent::give_back_late_grants() {
 bool LogicalAgent::stop_vehicle() {
   // The moves the RAN has not reported ended, oldest first: a cancel ends the move it names
   // and every one queued after it, but the RAN refuses to cancel a move that has ended (the
-  // report may be on its way), so each is tried in turn.
+  // report may be on its way), and its reply does not say so: each is cancelled in turn (a
+  // cancel of one ended by an earlier cancel is refused alike, and harmless).
   std::vector<ran::CommandId> unended;
   {
     std::lock_guard lock(mutex_);
@@ -889,11 +890,12 @@ bool LogicalAgent::stop_vehicle() {
       auto cancelled = ran_->cancel(id, options_.call_timeout);
       if (cancelled) {
         delivered = true;
-        break;
+        continue;
       }
       if (nobody_answered(cancelled.error())) {  // the RAN is out of reach: said once
         if (!stop_undelivered_) spdlog::warn("cancel of move '{}' not delivered: {}", id, cancelled.error().message);
         stop_undelivered_ = true;
+        delivered = false;  // the moves after it may run on
         break;
       }
       spdlog::info("cancel of move '{}' not taken: {}", id, cancelled.error().message);

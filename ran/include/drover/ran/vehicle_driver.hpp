@@ -45,8 +45,9 @@ class StatusSink {
 ///    after it fail too (they started where it should have ended).
 ///  - The vehicle stays inside the motion area of the move it executes; a move it cannot
 ///    execute inside its area is rejected, never started.
-///  - Status is reported on every change and at least every status period while the
-///    vehicle moves (on_tick is the natural place).
+///  - Status is reported on every change and at least every status period, whether the
+///    vehicle moves or not (on_tick is the natural place): a commander that hears nothing
+///    for 3 s takes the RAN for lost.
 class VehicleDriver {
  public:
   virtual ~VehicleDriver() = default;
