@@ -254,7 +254,7 @@ void add_launch_command(CLI::App& app, CommandContext& context) {
                       "Real seconds an agent gets to end after SIGTERM before SIGKILL (default 5)")
       ->transform(cli::non_negative());
   command->add_option("--log-level", arguments->log_level, "The launcher's own log level (default warn)")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+      ->check(cli::log_level());
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }
 

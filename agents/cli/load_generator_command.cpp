@@ -137,8 +137,8 @@ void add_load_generator_command(CLI::App& app, CommandContext& context) {
   command->add_option("--xml-profile", arguments->xml_profile, "Fast DDS XML profiles file")
       ->check(CLI::ExistingFile);
   add_clock_options(*command, arguments->clock);
-  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off")
+      ->check(cli::log_level());
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }
 

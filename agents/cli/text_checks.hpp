@@ -4,6 +4,8 @@
 // and a vehicle "" address whichever logical agent answers first.
 // Add them with Option::check.
 
+#include <string_view>
+
 #include <CLI/CLI.hpp>
 
 namespace drover::cli {
@@ -14,5 +16,11 @@ CLI::Validator identifier();
 /// Any text but the empty one (an empty file name would be reported as a file named "",
 /// which no message makes clear).
 CLI::Validator non_empty();
+
+/// Whether `level` is a log level every agent takes: trace, debug, info, warn, error, off
+/// (spdlog would read any other text as off, silently).
+bool is_log_level(std::string_view level);
+/// --log-level of every agent: is_log_level.
+CLI::Validator log_level();
 
 }  // namespace drover::cli

@@ -93,8 +93,8 @@ void add_routing_agent_command(CLI::App& app, CommandContext& context) {
       ->transform(cli::positive());
   command->add_flag("--hold-after-prepare", arguments->hold_after_prepare,
                     "TEST HOOK: prepare real routes but never commit them (log a marker and wait)");
-  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off")
+      ->check(cli::log_level());
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }
 

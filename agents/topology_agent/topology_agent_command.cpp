@@ -100,8 +100,8 @@ void add_topology_agent_command(CLI::App& app, CommandContext& context) {
                       "its vehicle occupies; 0: never (default 10)")
       ->transform(cli::non_negative());
   add_clock_options(*command, arguments->clock);
-  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off")
+      ->check(cli::log_level());
   command->add_flag("--drop-commit-replies", arguments->drop_commit_replies,
                     "TEST HOOK: apply commits but never answer them (a reply lost on the way)");
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });

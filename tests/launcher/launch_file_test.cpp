@@ -235,6 +235,46 @@ TEST(LaunchFile, VerticesPartitionsAndProfilesMustExist) {
   EXPECT_NE(text.find("agents[3].stations[1]: 'south-west->south' is not a vertex"), std::string::npos) << text;
 }
 
+// Two topology agents owning the same entities: vehicles could be booked onto one entity
+// through either.
+TEST(LaunchFile, TopologyAgentsThatWouldOwnTheSameEntitiesAreRefused) {
+  const auto twice = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "topology", "id": "again"})"));
+  EXPECT_NE(twice.find("agents[1]: serves the whole topology, as agents[0] does already"), std::string::npos)
+      << twice;
+  const auto beside = problems_of(R"({"topology": "topologies/warehouse.json", "agents": [
+      {"kind": "topology"}, {"kind": "topology", "partition": "west"}]})");
+  EXPECT_NE(beside.find("agents[1].partition: partition 'west' is served by agents[0] already (it serves the whole "
+                        "topology)"),
+            std::string::npos)
+      << beside;
+}
+
+// A simulator driving slower than its logical agent plans falls behind every window.
+TEST(LaunchFile, AVehicleSimulatedAndPlannedWithDifferentProfilesIsRefused) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology"}, {"kind": "routing"},
+      {"kind": "ran-sim", "vehicle": "V1", "at": "south-west", "profile": "slow"},
+      {"kind": "logical", "vehicle": "V1"})"));
+  EXPECT_NE(text.find("agents[3].profile: vehicle 'V1' is planned with no profile but simulated with profile 'slow' "
+                      "(agents[2]): name the same profile in both"),
+            std::string::npos)
+      << text;
+}
+
+// What the agents would refuse at start: refused in the file, before anything starts.
+TEST(LaunchFile, VehicleIdsAndLogLevelsTheAgentsWouldRefuseAreRefused) {
+  const auto text = problems_of(loop_file(R"({"kind": "topology", "log_level": "loud"},
+      {"kind": "ran-sim", "id": "sim1", "vehicle": "V\u00011", "at": "south-west"},
+      {"kind": "routing", "log_level": "warning"})"));
+  EXPECT_NE(text.find("agents[0].log_level: must be one of \"trace\", \"debug\", \"info\", \"warn\", \"error\", "
+                      "\"off\""),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("agents[1].vehicle: 'V\\x011' contains the control character 0x01 at byte 1"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("agents[2].log_level: must be one of"), std::string::npos) << text;
+}
+
 TEST(LaunchFile, BadProfileFields) {
   const auto text = problems_of(R"({"topology": "topologies/loop.json",
       "vehicle_profiles": {"x": {"max_speed": 0, "warp": 9}, "y": 3}, "agents": [{"kind": "routing"}]})");

@@ -12,8 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/cli/number_checks.hpp"
+#include "agents/cli/text_checks.hpp"
 #include "drover/carp/vehicle_profile_json.hpp"
 #include "drover/common/clock.hpp"
+#include "drover/common/identifier.hpp"
 #include "drover/common/json_document.hpp"
 #include "drover/common/text_file.hpp"
 #include "drover/dds/participant.hpp"
@@ -30,7 +32,7 @@ using Json = nlohmann::json;
 
 /// What a field's value must be, and how it becomes a command-line value.
 enum class FieldType {
-  text,             ///< a non-empty string
+  log_level,        ///< one of the agents' log levels (cli::is_log_level)
   vertex,           ///< the id of a vertex of the topology
   vertex_list,      ///< a non-empty array of vertex ids (one option per id)
   partition,        ///< a partition named by the topology
@@ -101,15 +103,15 @@ const std::vector<KindRules>& kind_rules() {
        {{"partition", "--partition", FieldType::partition},
         {"db", "--db", FieldType::journal},
         {"departed_after", "--departed-after", FieldType::number},
-        {"log_level", "--log-level", FieldType::text}}},
+        {"log_level", "--log-level", FieldType::log_level}}},
       {AgentKind::ran_sim, "ran-sim", "ran-sim", "--agent-id", "--id", true, true,
        {{"at", "--at", FieldType::vertex},
         {"heading", "--heading", FieldType::number, -1000, 1000},
         {"loaded", "--loaded", FieldType::flag},
         {"status_period_ms", "--status-period-ms", FieldType::count, 1, 60000},
-        {"log_level", "--log-level", FieldType::text}}},
+        {"log_level", "--log-level", FieldType::log_level}}},
       {AgentKind::routing, "routing", "routing-agent", "--id", "", false, false,
-       {{"log_level", "--log-level", FieldType::text}}},
+       {{"log_level", "--log-level", FieldType::log_level}}},
       {AgentKind::logical, "logical", "logical-agent", "--id", "", true, true,
        {{"lookahead", "--lookahead", FieldType::count, 1, 1000},
         {"delay_threshold", "--delay-threshold", FieldType::positive_number},
@@ -120,12 +122,12 @@ const std::vector<KindRules>& kind_rules() {
         {"route_limit", "--route-limit", FieldType::number},
         {"wait_alarm", "--wait-alarm", FieldType::number},
         {"db", "--db", FieldType::journal},
-        {"log_level", "--log-level", FieldType::text}}},
+        {"log_level", "--log-level", FieldType::log_level}}},
       {AgentKind::load_generator, "load-generator", "load-generator", "--id", "", false, true,
        {{"seed", "--seed", FieldType::count, 0, kLargestWhole},
         {"stations", "--station", FieldType::vertex_list},
         {"max_orders", "--max-orders", FieldType::count, 0, kLargestWhole},
-        {"log_level", "--log-level", FieldType::text}}},
+        {"log_level", "--log-level", FieldType::log_level}}},
   };
   return rules;
 }
@@ -386,6 +388,11 @@ class LaunchFileParser {
     }
     if (has_vehicle && agent.vehicle.empty()) {
       checker_.problem(join(where, "vehicle"), "missing: the vehicle id");
+    } else if (has_vehicle) {
+      // The subcommand takes it as an id (a DDS key): refused there, the agent would not start.
+      if (auto problem = identifier_problem(agent.vehicle)) {
+        checker_.problem(join(where, "vehicle"), "'" + printable_identifier(agent.vehicle) + "' " + *problem);
+      }
     }
     if (rules->kind == AgentKind::ran_sim && !entry.contains("at")) {
       checker_.problem(join(where, "at"), "missing: the vertex the vehicle starts at");
@@ -418,6 +425,9 @@ class LaunchFileParser {
     partitions_.push_back(entry.contains("partition") && entry["partition"].is_string()
                               ? entry["partition"].get<std::string>()
                               : "");
+    profile_names_.push_back(entry.contains("profile") && entry["profile"].is_string()
+                                 ? entry["profile"].get<std::string>()
+                                 : "");
     file_.agents.push_back(std::move(agent));
   }
 
@@ -474,9 +484,9 @@ class LaunchFileParser {
                   std::vector<std::string>& options) {
     const std::string option(rule.option);
     switch (rule.type) {
-      case FieldType::text:
-        if (!value.is_string() || value.get<std::string>().empty()) {
-          return checker_.problem(where, "must be a non-empty string");
+      case FieldType::log_level:
+        if (!value.is_string() || !cli::is_log_level(value.get<std::string>())) {
+          return checker_.problem(where, "must be one of \"trace\", \"debug\", \"info\", \"warn\", \"error\", \"off\"");
         }
         options.insert(options.end(), {option, value.get<std::string>()});
         return;
@@ -565,13 +575,15 @@ class LaunchFileParser {
   }
 
   /// Checks across entries: unique ids, one RAN per vehicle, start vertices apart,
-  /// topology agents covering every partition once.
+  /// topology agents covering every partition once, a vehicle's simulator and logical agent
+  /// on one profile.
   void check_fleet() {
     std::map<std::string, std::size_t> ids;
     std::map<std::string, std::size_t> ran_vehicles;
+    std::map<std::string, std::size_t> logical_vehicles;
     std::map<std::string, std::size_t> partition_owner;
     std::map<topology::EntityIndex, std::size_t> start_owner;
-    bool whole_topology_served = false;
+    std::optional<std::size_t> whole_topology_owner;  // a topology agent without a partition
     bool any_topology_agent = false;
     for (std::size_t index = 0; index < file_.agents.size(); ++index) {
       const auto& agent = file_.agents[index];
@@ -587,22 +599,55 @@ class LaunchFileParser {
         }
         check_start(index, start_owner);
       }
+      if (agent.kind == AgentKind::logical) logical_vehicles.emplace(agent.vehicle, index);
       if (agent.kind == AgentKind::topology) {
         any_topology_agent = true;
         if (partitions_[index].empty()) {
-          whole_topology_served = true;
+          // It serves every partition: two agents would own the same entities, and vehicles
+          // could be booked onto one entity through either.
+          if (whole_topology_owner) {
+            checker_.problem(where, "serves the whole topology, as " + wheres_[*whole_topology_owner] +
+                                        " does already (give each topology agent its own \"partition\")");
+          } else {
+            whole_topology_owner = index;
+          }
         } else if (auto [it, inserted] = partition_owner.emplace(partitions_[index], index); !inserted) {
           checker_.problem(where + ".partition", "partition '" + partitions_[index] + "' is served by " +
                                                      wheres_[it->second] + " already");
         }
       }
     }
-    if (topology_ && any_topology_agent && !whole_topology_served) {
+    if (whole_topology_owner) {
+      for (const auto& [partition, index] : partition_owner) {
+        checker_.problem(wheres_[index] + ".partition", "partition '" + partition + "' is served by " +
+                                                            wheres_[*whole_topology_owner] +
+                                                            " already (it serves the whole topology)");
+      }
+    }
+    check_profiles(ran_vehicles, logical_vehicles);
+    if (topology_ && any_topology_agent && !whole_topology_owner) {
       for (const auto& partition : topology_->partitions()) {
         if (!partition_owner.contains(partition)) {
           checker_.problem("agents", "no topology agent serves partition '" + partition + "'");
         }
       }
+    }
+  }
+
+  /// A vehicle's simulator drives with its profile's speeds, and its logical agent plans with
+  /// them: both must name the same profile (or neither), or the vehicle runs behind or ahead
+  /// of the windows reserved for it.
+  void check_profiles(const std::map<std::string, std::size_t>& rans,
+                      const std::map<std::string, std::size_t>& logicals) {
+    for (const auto& [vehicle, ran] : rans) {
+      const auto logical = logicals.find(vehicle);
+      if (logical == logicals.end() || profile_names_[ran] == profile_names_[logical->second]) continue;
+      const auto named = [&](std::size_t index) {
+        return profile_names_[index].empty() ? std::string("no profile") : "profile '" + profile_names_[index] + "'";
+      };
+      checker_.problem(wheres_[logical->second] + ".profile",
+                       "vehicle '" + vehicle + "' is planned with " + named(logical->second) + " but simulated with " +
+                           named(ran) + " (" + wheres_[ran] + "): name the same profile in both");
     }
   }
 
@@ -634,10 +679,12 @@ class LaunchFileParser {
   };
   std::map<std::string, Profile> profiles_;
   std::map<std::string, std::string> journal_users_;  ///< journal file -> the field naming it first
-  // Per agent entry, parallel to file_.agents: its start vertex, its place, its partition.
+  // Per agent entry, parallel to file_.agents: its start vertex, its place, its partition,
+  // the vehicle profile it names.
   std::vector<std::string> starts_;
   std::vector<std::string> wheres_;
   std::vector<std::string> partitions_;
+  std::vector<std::string> profile_names_;
 };
 
 }  // namespace

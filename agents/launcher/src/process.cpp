@@ -20,18 +20,24 @@ void close_pair(int fds[2]) {
   if (fds[1] >= 0) ::close(fds[1]);
 }
 
-/// In the child between fork and exec: only async-signal-safe calls.
+/// In the child between fork and exec: only async-signal-safe calls. `open_max` bounds the
+/// descriptors closed one by one where close_range is missing (kernels before 5.9).
 [[noreturn]] void exec_child(pid_t parent, const char* executable, char* const* argv, int out_fd,
-                             int err_fd) {
+                             int err_fd, int open_max) {
   sigset_t none;
   sigemptyset(&none);
   sigprocmask(SIG_SETMASK, &none, nullptr);
+  struct sigaction by_default {};
+  by_default.sa_handler = SIG_DFL;
+  sigaction(SIGPIPE, &by_default, nullptr);  // the launcher ignores it; an ignored one is inherited
   setpgid(0, 0);
   prctl(PR_SET_PDEATHSIG, SIGTERM);
   if (getppid() != parent) _exit(1);  // the parent died before prctl took effect
   if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
   if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
-  close_range(3, UINT_MAX, 0);
+  if (close_range(3, UINT_MAX, 0) != 0) {
+    for (int fd = 3; fd < open_max; ++fd) close(fd);
+  }
   execv(executable, argv);
   const char* reason = strerror(errno);
   const char prefix[] = "error: cannot execute ";
@@ -56,13 +62,17 @@ Result<pid_t> spawn_child(const std::string& executable, const std::vector<std::
   for (auto& argument : storage) argv.push_back(argument.data());
   argv.push_back(nullptr);
 
+  const long open_max = ::sysconf(_SC_OPEN_MAX);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     return fail(ErrorCode::io,
                 "cannot fork to start " + executable + ": " + std::strerror(errno));
   }
-  if (pid == 0) exec_child(parent, storage.front().c_str(), argv.data(), stdout_fd, stderr_fd);
+  if (pid == 0) {
+    exec_child(parent, storage.front().c_str(), argv.data(), stdout_fd, stderr_fd,
+               open_max > 0 && open_max < 1'000'000 ? static_cast<int>(open_max) : 65536);
+  }
   return pid;
 }
 

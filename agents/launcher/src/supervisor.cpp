@@ -49,6 +49,8 @@ sigset_t supervised_signals() {
   sigemptyset(&set);
   sigaddset(&set, SIGINT);
   sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGHUP);   // the terminal or the ssh session went away
+  sigaddset(&set, SIGQUIT);
   sigaddset(&set, SIGCHLD);
   return set;
 }
@@ -61,6 +63,14 @@ Status Supervisor::block_signals() {
   const sigset_t set = supervised_signals();
   if (const int error = pthread_sigmask(SIG_BLOCK, &set, nullptr); error != 0) {
     return fail(ErrorCode::io, std::string("cannot block signals: ") + std::strerror(error));
+  }
+  // A reader of our output that ends (`| tee` on Ctrl-C) must not kill the launcher mid-way:
+  // the agents are still to be stopped in order. Writes then fail instead (children get
+  // the default back, spawn_child).
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  if (::sigaction(SIGPIPE, &ignore, nullptr) != 0) {
+    return fail(ErrorCode::io, std::string("cannot ignore SIGPIPE: ") + std::strerror(errno));
   }
   return {};
 }

@@ -14,7 +14,7 @@ Result<std::unique_ptr<TraceWriter>> TraceWriter::open(const std::filesystem::pa
                   "--trace: " + path.string() + " is an input of this launch; tracing would overwrite it");
     }
   }
-  std::FILE* file = std::fopen(path.c_str(), "w");
+  std::FILE* file = std::fopen(path.c_str(), "we");  // close-on-exec: the agents do not inherit it
   if (file == nullptr) {
     return fail(ErrorCode::io, "--trace: cannot create " + path.string() + ": " + std::strerror(errno));
   }
@@ -28,7 +28,9 @@ void TraceWriter::write(TimeNs time, const std::string& type, const nlohmann::js
   line["t"] = time;
   line["type"] = type;
   for (const auto& [key, value] : fields.items()) line[key] = value;
-  const std::string text = line.dump() + "\n";
+  // Bytes that are not UTF-8 (ids or texts from a RAN, a path) are replaced: dump would
+  // throw, and the line, with the figures counted after it, would be lost.
+  const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   std::lock_guard lock(mutex_);
   if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() && write_error_ == 0) {
     write_error_ = errno != 0 ? errno : EIO;

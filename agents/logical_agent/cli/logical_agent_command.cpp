@@ -147,7 +147,8 @@ void add_logical_agent_command(CLI::App& app, CommandContext& context) {
   command->add_option("--wait-alarm", arguments->wait_alarm,
                       "s waiting for one allocation before the operator is warned; 0: never (default 60)")
       ->transform(cli::non_negative());
-  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
+  command->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off")
+      ->check(cli::log_level());
   command->callback([arguments, &context] { context.exit_code = run(*arguments); });
 }
 

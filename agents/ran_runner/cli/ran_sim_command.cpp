@@ -146,7 +146,8 @@ void add_ran_commands(CLI::App& app, CommandContext& context) {
   sim->add_option("--status-period-ms", arguments->status_period_ms,
                   "Real milliseconds between status reports (default 100)")
       ->transform(cli::whole_in(1, 60000));
-  sim->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off");
+  sim->add_option("--log-level", arguments->log_level, "trace, debug, info, warn, error, off")
+      ->check(cli::log_level());
   auto& vehicle = arguments->vehicle;
   sim->add_option("--max-speed", vehicle.max_speed, "m/s (default 1)")->transform(cli::positive());
   sim->add_option("--acceleration", vehicle.acceleration, "m/s^2 (default 0.5)")->transform(cli::positive());

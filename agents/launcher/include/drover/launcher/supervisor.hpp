@@ -59,9 +59,10 @@ class Supervisor {
   /// Called every tick period while the agents run; returns a reason to stop, or nullopt.
   using Tick = std::function<std::optional<std::string>()>;
 
-  /// Blocks SIGINT, SIGTERM and SIGCHLD in the calling thread, and so in every thread it
-  /// creates afterwards, so that the supervisor receives them through a signalfd. Call it
-  /// first in main, before any thread exists. \return success, or io.
+  /// Blocks SIGINT, SIGTERM, SIGHUP, SIGQUIT and SIGCHLD in the calling thread, and so in
+  /// every thread it creates afterwards, so that the supervisor receives them through a
+  /// signalfd; ignores SIGPIPE. Call it first in main, before any thread exists.
+  /// \return success, or io.
   static Status block_signals();
 
   Supervisor(std::vector<AgentEntry> agents, SupervisorOptions options, Console& console);
@@ -73,7 +74,7 @@ class Supervisor {
   /// stop, then stops them in reverse kind order (load generators, logical agents,
   /// routing agents, simulated RANs, topology agents), each stage SIGTERM then SIGKILL
   /// after the grace period. A second SIGINT / SIGTERM while stopping kills the rest at
-  /// once. Requires block_signals() first.
+  /// once (SIGHUP and SIGQUIT stop it as SIGTERM does). Requires block_signals() first.
   /// \return how the agents ended, or io when the signalfd cannot be made (nothing started).
   Result<SupervisorOutcome> run(const Tick& tick);
 
