@@ -152,6 +152,12 @@ int run(const LaunchArguments& arguments) {
     std::cerr << "error: " << exists.error().message << "\n";
     return kExitBadInput;
   }
+  // Journal directories and profile files: none may fail at an agent's start after others
+  // started.
+  if (auto prepared = launcher::prepare_state(*file); !prepared) {
+    std::cerr << "error: " << prepared.error().message << " (nothing started)\n";
+    return kExitBadInput;
+  }
   std::unique_ptr<launcher::TraceWriter> trace;
   if (!arguments.trace_file.empty()) {
     auto opened = launcher::TraceWriter::open(arguments.trace_file, {file->path, file->topology_file});

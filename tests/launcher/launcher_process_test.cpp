@@ -131,8 +131,10 @@ TEST(LauncherProcess, AgentsEndWhenTheLauncherIsKilled) {
 
 TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   const auto dir = scratch_dir("launch_duration");
+  // A journal in a directory of the state directory: made before anything starts (before,
+  // the topology agent failed at its start: "its directory does not exist").
   write_text(dir / "fleet.json", loop_launch(95, R"(
-      {"kind": "topology"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
+      {"kind": "topology", "db": "journals/loop.db"}, {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   // 100 simulated seconds at time factor 10: 10 s for both agents to start, discover each
   // other and trace a status, on a loaded host too.
   // The trace goes into a state directory the launch makes (made before the trace opens).
@@ -153,14 +155,15 @@ TEST(LauncherProcess, StopsAfterDurationAndWritesTheTrace) {
   EXPECT_NE(trace.find("\"type\":\"ran_status\""), std::string::npos) << trace.substr(0, 400);
   EXPECT_NE(trace.find("\"vehicle\":\"V1\""), std::string::npos);
   EXPECT_NE(trace.find("\"footprint\":[["), std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_regular_file(state / "journals" / "loop.db"));
   std::filesystem::remove_all(dir);
 }
 
 TEST(LauncherProcess, AgentFailingForGoodMakesExitOne) {
   const auto dir = scratch_dir("launch_failure");
-  // The journal's directory does not exist: the topology agent exits 1, and is not restarted.
+  // The journal is a directory: the topology agent exits 1, and is not restarted.
   write_text(dir / "fleet.json", loop_launch(96, R"(
-      {"kind": "topology", "db": "/nonexistent-dir/loop.db"},
+      {"kind": "topology", "db": ")" + dir.string() + R"("},
       {"kind": "ran-sim", "vehicle": "V1", "at": "south-west"})"));
   auto launcher = start_launch(dir, {"--duration", "30"});
   ASSERT_TRUE(launcher.has_value());
@@ -191,6 +194,23 @@ TEST(LauncherProcess, BadLaunchFileStartsNothing) {
   EXPECT_NE(err.find("fleet.json:agents[1].at: 'atlantis' is not a vertex of"), std::string::npos) << err;
   EXPECT_EQ(err.find("started"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(state));
+
+  // A journal directory that cannot be made (its parent is a file): refused before any
+  // agent starts, not an agent failing at its start beside others that run.
+  write_text(dir / "fleet.json", loop_launch(97, R"(
+      {"kind": "routing"}, {"kind": "topology", "db": ")" + (dir / "fleet.json" / "j" / "loop.db").string() + R"("})"));
+  auto second = start_launch(dir);
+  ASSERT_TRUE(second.has_value());
+  const auto refused = second->wait_exit(60s);
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_TRUE(refused->exited);
+  EXPECT_EQ(refused->code, 2);
+  const auto why = read_file((dir / "err.txt").string());
+  EXPECT_NE(why.find("error: agent 'topology': cannot create directory " + (dir / "fleet.json" / "j").string()),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("(nothing started)"), std::string::npos) << why;
+  EXPECT_EQ(why.find("started routing"), std::string::npos) << why;
   std::filesystem::remove_all(dir);
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
@@ -382,7 +383,7 @@ class LaunchFileParser {
         if (rule == nullptr) {
           checker_.problem(field, "unknown field for kind '" + std::string(rules->name) + "'");
         } else {
-          add_option(*rule, value, field, agent.options);
+          add_option(*rule, value, field, agent.options, &agent.journals);
         }
       }
     }
@@ -480,8 +481,10 @@ class LaunchFileParser {
     return "agent";
   }
 
+  /// Adds the option `rule` makes of `value` to `options` (a journal's path also to
+  /// `journals`, when given), or reports why it cannot.
   void add_option(const FieldRule& rule, const Json& value, const std::string& where,
-                  std::vector<std::string>& options) {
+                  std::vector<std::string>& options, std::vector<std::filesystem::path>* journals = nullptr) {
     const std::string option(rule.option);
     switch (rule.type) {
       case FieldType::log_level:
@@ -559,6 +562,7 @@ class LaunchFileParser {
           return checker_.problem(where, "journal " + file + " is " + other->second + "'s too (one journal per agent)");
         }
         options.insert(options.end(), {option, file});
+        if (journals != nullptr) journals->push_back(file);
         return;
       }
     }
@@ -688,6 +692,28 @@ class LaunchFileParser {
 };
 
 }  // namespace
+
+Status prepare_state(const LaunchFile& file) {
+  for (const auto& agent : file.agents) {
+    std::vector<std::filesystem::path> directories;
+    for (const auto& journal : agent.journals) directories.push_back(journal.parent_path());
+    for (const auto& [path, content] : agent.files) directories.push_back(path.parent_path());
+    for (const auto& directory : directories) {
+      std::error_code error;
+      std::filesystem::create_directories(directory, error);
+      if (error) {
+        return fail(ErrorCode::io, "agent '" + agent.id + "': cannot create directory " + directory.string() + ": " +
+                                       error.message());
+      }
+    }
+    for (const auto& [path, content] : agent.files) {
+      std::ofstream out(path);
+      out << content;
+      if (!out.flush()) return fail(ErrorCode::io, "agent '" + agent.id + "': cannot write " + path.string());
+    }
+  }
+  return {};
+}
 
 std::string_view kind_name(AgentKind kind) noexcept { return rules_of(kind).name; }
 std::string_view subcommand(AgentKind kind) noexcept { return rules_of(kind).subcommand; }

@@ -10,7 +10,6 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <map>
 
 #include "drover/launcher/process.hpp"
@@ -139,16 +138,6 @@ void Supervisor::start(std::size_t index) {
   std::vector<std::string> arguments{std::string(subcommand(agent.entry.kind))};
   arguments.insert(arguments.end(), agent.entry.options.begin(), agent.entry.options.end());
   arguments.insert(arguments.end(), options_.common_options.begin(), options_.common_options.end());
-  for (const auto& [path, content] : agent.entry.files) {
-    std::ofstream file(path);
-    file << content;
-    if (!file.flush()) {
-      agent.failed = true;
-      agent.last_end = agent.last_failure = "could not start: cannot write " + path.string();
-      console_.note(agent.entry.id + " " + agent.last_end);
-      return;
-    }
-  }
   auto spawned = spawn_process(options_.executable, arguments);
   if (!spawned) {
     agent.failed = true;

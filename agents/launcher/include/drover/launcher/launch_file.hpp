@@ -45,9 +45,11 @@ struct AgentEntry {
   /// the kind takes one, then the entry's fields and its vehicle profile. The launcher
   /// adds the domain id and the clock.
   std::vector<std::string> options;
-  /// Files to write before the agent starts (path, content): a logical agent's vehicle
+  /// Files to write before anything starts (path, content): a logical agent's vehicle
   /// profile, made from the launch file's profile, lives in the state directory.
   std::vector<std::pair<std::filesystem::path, std::string>> files;
+  /// The journals it opens (`db`): their directories are made before anything starts.
+  std::vector<std::filesystem::path> journals;
 };
 
 /// A parsed and checked launch file.
@@ -82,5 +84,10 @@ Result<LaunchFile, LaunchProblems> load_launch_file(const std::filesystem::path&
 Result<LaunchFile, LaunchProblems> parse_launch_file(std::string_view text,
                                                      const std::filesystem::path& path,
                                                      const std::filesystem::path& state_dir);
+
+/// Makes what the agents of `file` need on disk before any of them starts, so that none
+/// fails at its start after others started: the directories of their journals, and their
+/// files (AgentEntry::files). \return success, or io naming the path and the agent.
+Status prepare_state(const LaunchFile& file);
 
 }  // namespace drover::launcher
