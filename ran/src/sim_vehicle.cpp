@@ -232,9 +232,11 @@ CommandCheck SimVehicle::cancel(const CommandId& command) {
     // A turn or an operation stops at once.
     angular_speed_ = 0;
     remove_cancelled();
-  } else if (first > 0 && speed_ * speed_ / (2 * config_.deceleration) <=
-                              distance_to_task(first) + kRoundOff) {
-    // The vehicle can stop before it reaches the cancelled commands: drop them now.
+  } else if (first > 0 && !tasks_.front().cancel_requested &&
+             speed_ * speed_ / (2 * config_.deceleration) <= distance_to_task(first) + kRoundOff) {
+    // The vehicle can stop before it reaches the cancelled commands: drop them now. (Not
+    // when the head is cancelled already: the vehicle brakes, and the rest goes with the
+    // head once it stands, as a commander cancelling each command in turn has it.)
     remove_cancelled();
   }
   // Otherwise the vehicle brakes along its path and the rest is cancelled once it stands.

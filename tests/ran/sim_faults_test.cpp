@@ -197,6 +197,24 @@ TEST(SimCancel, RunningMoveBrakesAndEndsCancelledWithWhatFollows) {
   EXPECT_DOUBLE_EQ(vehicle.status().pose.x, 5.0);
 }
 
+// The logical agent cancels each move it has not seen end, oldest first: a cancel of a
+// later one while the vehicle brakes for the first must not stop it dead.
+TEST(SimCancel, CancellingEachQueuedMoveInTurnStillBrakesAlongThePath) {
+  const auto world = test::world();
+  auto vehicle = vehicle_at(world, "A");
+  ASSERT_TRUE(vehicle.submit(move(*world, "m1", "A", "ab", "B", 1.0)));
+  ASSERT_TRUE(vehicle.submit(move(*world, "m2", "B", "bc", "C", 1.0)));
+  vehicle.step(seconds_to_ns(3));  // x = 2 at 1 m/s
+  ASSERT_TRUE(vehicle.cancel("m1"));
+  ASSERT_TRUE(vehicle.cancel("m2"));
+  EXPECT_EQ(state_of(vehicle, "m1"), CommandState::running);  // still braking
+  EXPECT_GT(vehicle.status().linear_speed, 0.5);
+  vehicle.step(seconds_to_ns(2));
+  EXPECT_EQ(state_of(vehicle, "m1"), CommandState::cancelled);
+  EXPECT_EQ(state_of(vehicle, "m2"), CommandState::cancelled);
+  EXPECT_NEAR(vehicle.status().pose.x, 3.0, 1e-9);  // 1 m of braking at 0.5 m/s²
+}
+
 TEST(SimCancel, QueuedMoveIsDroppedAndTheVehicleStopsBeforeIt) {
   const auto world = test::world();
   auto vehicle = vehicle_at(world, "A");
