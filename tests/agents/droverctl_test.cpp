@@ -219,7 +219,8 @@ TEST_F(DroverctlTest, PauseAllAsksEveryLiveVehicleLeavesPausedOnesAsTheyAreAndFa
   FakeLogicalAgent v8(kDomain, paused);
   std::string out, err;
   // V7 is asked and does not answer: exit 1 naming it; V8 is left as it is.
-  auto status = run_droverctl({"pause", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "3"},
+  // Discovery ends once both states are in; --timeout only bounds a loaded machine.
+  auto status = run_droverctl({"pause", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "10"},
                               out, err);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 1) << out << err;
@@ -228,7 +229,7 @@ TEST_F(DroverctlTest, PauseAllAsksEveryLiveVehicleLeavesPausedOnesAsTheyAreAndFa
   EXPECT_EQ(err.find("vehicle 'V8'"), std::string::npos) << err;
   // Resuming those paused for another reason: V8 stays paused, V7 is not paused; nothing
   // is asked, so nothing fails.
-  status = run_droverctl({"resume", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "3"}, out,
+  status = run_droverctl({"resume", "--all", "--reason", "shift change", "--domain", domain, "--timeout", "10"}, out,
                          err);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->code, 0) << out << err;
@@ -248,12 +249,14 @@ TEST_F(DroverctlTest, PauseAndResumeAllAskNoVehicleWhoseStateDidNotArriveAndFail
   const std::string domain = std::to_string(kDomain);
   FakeLogicalAgent v6(kDomain, vehicle_state("V6", msg::VEHICLE_PAUSED, "aisle-1", "", 0.9, false), false);
   std::string out, err;
+  // The whole --timeout passes each time (the state never comes): long enough for V6's
+  // heartbeat to be heard on a loaded machine, or it would not count as live.
   for (const std::string command : {"pause", "resume"}) {
-    auto status = run_droverctl({command, "--all", "--reason", "shift change", "--domain", domain, "--timeout", "2"},
+    auto status = run_droverctl({command, "--all", "--reason", "shift change", "--domain", domain, "--timeout", "10"},
                                 out, err);
     ASSERT_TRUE(status.has_value());
     EXPECT_EQ(status->code, 1) << command << ": " << out << err;
-    EXPECT_NE(err.find("error: vehicle 'V6' not " + command + "d: its state did not arrive within 2 s"),
+    EXPECT_NE(err.find("error: vehicle 'V6' not " + command + "d: its state did not arrive within 10 s"),
               std::string::npos)
         << command << ": " << err;
   }
