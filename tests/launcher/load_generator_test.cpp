@@ -21,6 +21,7 @@
 #include "drover/launcher/load_generator.hpp"
 #include "drover/logical_agent/messages.hpp"
 #include "drover/logical_agent/names.hpp"
+#include "tests/agents/dds_test_support.hpp"
 
 namespace drover::test {
 namespace {
@@ -29,15 +30,6 @@ using namespace std::chrono_literals;
 using OrderServer = dds::ServiceServer<msg::OrderRequest, msg::OrderReply>;
 
 constexpr auto kTimeout = 60s;
-
-std::unique_ptr<dds::Participant> participant(std::uint32_t domain, const std::string& id) {
-  dds::ParticipantOptions options;
-  options.domain_id = domain;
-  options.agent_id = id;
-  auto created = dds::Participant::create(options);
-  EXPECT_TRUE(created.has_value()) << (created ? "" : created.error().message);
-  return created ? std::move(*created) : nullptr;
-}
 
 /// The order requests each vehicle's server received, in order.
 struct Received {
@@ -95,30 +87,47 @@ msg::VehicleState idle(const std::string& vehicle, std::int64_t time) {
   return state;
 }
 
+/// The generator under test on its own participant, and a writer of vehicle states (on
+/// `vehicles`) that its reader has matched. Members go in reverse: the generator before its
+/// participant.
+struct GeneratorRun {
+  std::unique_ptr<dds::Writer<msg::VehicleState>> states;
+  std::unique_ptr<dds::Participant> participant;
+  std::unique_ptr<launcher::LoadGenerator> generator;
+};
+
+void start_generator(std::uint32_t domain, dds::Participant& vehicles, GeneratorRun& run) {
+  auto states = dds::Writer<msg::VehicleState>::create(vehicles, logical_agent::kVehicleStateTopic);
+  ASSERT_TRUE(states.has_value()) << states.error().message;
+  run.states = std::move(*states);
+  run.participant = make_participant(domain, "load-generator");
+  ASSERT_TRUE(run.participant);
+  launcher::LoadGeneratorOptions options;
+  options.stations = {"a", "b"};
+  options.request_timeout = kTimeout;
+  auto generator = launcher::LoadGenerator::create(*run.participant, options);
+  ASSERT_TRUE(generator.has_value()) << generator.error().message;
+  run.generator = std::move(*generator);
+  ASSERT_TRUE(run.states->wait_for_readers(1, kTimeout)) << "the generator's vehicle reader never matched";
+}
+
 TEST(LoadGenerator, AVehicleThatRefusesAnOrderAsInvalidGetsNoMoreWhileTheOthersDo) {
   constexpr std::uint32_t kDomain = 29;
   Received received;
-  auto v1 = participant(kDomain, "V1");
-  auto v2 = participant(kDomain, "V2");
+  auto v1 = make_participant(kDomain, "V1");
+  auto v2 = make_participant(kDomain, "V2");
   ASSERT_TRUE(v1 && v2);
   // V1's RAN does not load: its logical agent refuses every order the generator sends.
   auto refusing = order_server(*v1, received, Error{ErrorCode::invalid_argument,
                                                     "vehicle 'V1' does not perform 'load' (its RAN performs: charge)"});
   auto accepting = order_server(*v2, received, std::nullopt);
   ASSERT_TRUE(refusing && accepting);
-  auto states = dds::Writer<msg::VehicleState>::create(*v1, logical_agent::kVehicleStateTopic);
-  ASSERT_TRUE(states.has_value()) << states.error().message;
+  GeneratorRun run;
+  ASSERT_NO_FATAL_FAILURE(start_generator(kDomain, *v1, run));
+  auto& states = run.states;
+  auto& generator = run.generator;
 
-  auto generator_participant = participant(kDomain, "load-generator");
-  ASSERT_TRUE(generator_participant);
-  launcher::LoadGeneratorOptions options;
-  options.stations = {"a", "b"};
-  options.request_timeout = kTimeout;
-  auto generator = launcher::LoadGenerator::create(*generator_participant, options);
-  ASSERT_TRUE(generator.has_value()) << generator.error().message;
-  ASSERT_TRUE((*states)->wait_for_readers(1, kTimeout)) << "the generator's vehicle reader never matched";
-
-  ASSERT_TRUE((*states)->write(idle("V1", 1)).has_value());
+  ASSERT_TRUE(states->write(idle("V1", 1)).has_value());
   ASSERT_TRUE(received.wait([&] { return received.count("V1") == 1; })) << "V1 got no order";
   {
     std::lock_guard lock(received.mutex);
@@ -127,52 +136,44 @@ TEST(LoadGenerator, AVehicleThatRefusesAnOrderAsInvalidGetsNoMoreWhileTheOthersD
     EXPECT_EQ(first.destinations()[0].operation(), "load");
     EXPECT_EQ(first.destinations()[1].operation(), "unload");
   }
-  ASSERT_TRUE(wait_figures(**generator, [](const auto& f) { return f.refused == 1; }));
+  ASSERT_TRUE(wait_figures(*generator, [](const auto& f) { return f.refused == 1; }));
   // V1 idle again, then V2 idle: the generator handles the states in order, so by the time
   // V2's order arrives it has decided on V1's second state (before, a second order went to
   // V1, and another at each of its state reports).
-  ASSERT_TRUE((*states)->write(idle("V1", 2)).has_value());
-  ASSERT_TRUE((*states)->write(idle("V2", 3)).has_value());
+  ASSERT_TRUE(states->write(idle("V1", 2)).has_value());
+  ASSERT_TRUE(states->write(idle("V2", 3)).has_value());
   ASSERT_TRUE(received.wait([&] { return received.count("V2") == 1; })) << "V2 got no order";
   {
     std::lock_guard lock(received.mutex);
     EXPECT_EQ(received.count("V1"), 1u) << "V1 was sent another order after refusing one as invalid";
   }
-  ASSERT_TRUE(wait_figures(**generator, [](const auto& f) { return f.queued == 1; }));
-  const auto figures = (*generator)->figures();
+  ASSERT_TRUE(wait_figures(*generator, [](const auto& f) { return f.queued == 1; }));
+  const auto figures = generator->figures();
   EXPECT_EQ(figures.queued, 1u);
   EXPECT_EQ(figures.refused, 1u);
   EXPECT_EQ(figures.left_out, 1u);
-  generator->reset();
 }
 
 TEST(LoadGenerator, AVehicleThatRefusesForAnotherReasonIsTriedAgain) {
   constexpr std::uint32_t kDomain = 57;
   Received received;
-  auto v1 = participant(kDomain, "V1");
+  auto v1 = make_participant(kDomain, "V1");
   ASSERT_TRUE(v1);
   // Not for what the order asks (its journal failed, say): the next order may be taken.
   auto refusing = order_server(*v1, received, Error{ErrorCode::unavailable, "the order journal cannot be written"});
   ASSERT_TRUE(refusing);
-  auto states = dds::Writer<msg::VehicleState>::create(*v1, logical_agent::kVehicleStateTopic);
-  ASSERT_TRUE(states.has_value()) << states.error().message;
-  auto generator_participant = participant(kDomain, "load-generator");
-  ASSERT_TRUE(generator_participant);
-  launcher::LoadGeneratorOptions options;
-  options.stations = {"a", "b"};
-  options.request_timeout = kTimeout;
-  auto generator = launcher::LoadGenerator::create(*generator_participant, options);
-  ASSERT_TRUE(generator.has_value()) << generator.error().message;
-  ASSERT_TRUE((*states)->wait_for_readers(1, kTimeout)) << "the generator's vehicle reader never matched";
+  GeneratorRun run;
+  ASSERT_NO_FATAL_FAILURE(start_generator(kDomain, *v1, run));
+  auto& states = run.states;
+  auto& generator = run.generator;
 
-  ASSERT_TRUE((*states)->write(idle("V1", 1)).has_value());
+  ASSERT_TRUE(states->write(idle("V1", 1)).has_value());
   ASSERT_TRUE(received.wait([&] { return received.count("V1") == 1; })) << "V1 got no order";
-  ASSERT_TRUE(wait_figures(**generator, [](const auto& f) { return f.refused == 1; }));
-  ASSERT_TRUE((*states)->write(idle("V1", 2)).has_value());
+  ASSERT_TRUE(wait_figures(*generator, [](const auto& f) { return f.refused == 1; }));
+  ASSERT_TRUE(states->write(idle("V1", 2)).has_value());
   ASSERT_TRUE(received.wait([&] { return received.count("V1") == 2; })) << "V1 was not tried again";
-  const auto figures = (*generator)->figures();
+  const auto figures = generator->figures();
   EXPECT_EQ(figures.left_out, 0u);
-  generator->reset();
 }
 
 }  // namespace
